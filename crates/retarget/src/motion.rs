@@ -1,0 +1,48 @@
+//! The retargeter's output: robot configurations over time, plus what they tracked.
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// The world targets the solver tracked, per frame and per target body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackedTargets {
+    /// Robot bodies with a task, in config (table) order.
+    pub body_names: Vec<String>,
+    /// `[frame * body_names.len() + k]`, metres, world frame (Z up).
+    pub pos: Vec<Vector3<f64>>,
+    /// Same layout; world orientation targets.
+    pub quat: Vec<UnitQuaternion<f64>>,
+}
+
+/// Joint trajectories for one robot: `qpos` per frame in MuJoCo's layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotMotion {
+    pub fps: f64,
+    /// Length of one configuration (MuJoCo `nq`).
+    pub nq: usize,
+    /// `frames × nq`, row-major. Free root first: x y z (m), quaternion w x y z, then the
+    /// other joints in MJCF order (rad or m).
+    pub qpos: Vec<f64>,
+    /// Names of the non-free joints, in qpos order.
+    pub joint_names: Vec<String>,
+    /// Every body of the model except the world, in MuJoCo order.
+    pub body_names: Vec<String>,
+    /// What the solver tracked, when known.
+    pub targets: Option<TrackedTargets>,
+}
+
+impl RobotMotion {
+    #[must_use]
+    pub fn num_frames(&self) -> usize {
+        if self.nq == 0 {
+            0
+        } else {
+            self.qpos.len() / self.nq
+        }
+    }
+
+    /// One frame's configuration.
+    #[must_use]
+    pub fn frame(&self, index: usize) -> &[f64] {
+        &self.qpos[index * self.nq..(index + 1) * self.nq]
+    }
+}
