@@ -33,11 +33,7 @@ pub struct RobotMotion {
 impl RobotMotion {
     #[must_use]
     pub fn num_frames(&self) -> usize {
-        if self.nq == 0 {
-            0
-        } else {
-            self.qpos.len() / self.nq
-        }
+        self.qpos.len().checked_div(self.nq).unwrap_or(0)
     }
 
     /// One frame's configuration.
