@@ -3,6 +3,8 @@
 //! This file only wires subcommands; each family lives in its own module and owns its
 //! arguments. Exit codes: 0 success, 1 bad input or failed job, 2 usage error (clap).
 
+#[allow(dead_code)] // wired to `retarget batch` once the pipeline lands
+mod batch;
 mod cmd_bvh;
 mod cmd_c3d;
 mod cmd_retarget;
@@ -54,4 +56,17 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// that an interrupted run never leaves a half-written file under the final name.
+pub(crate) fn atomic_write(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("{}: cannot write", path.display()))
 }
