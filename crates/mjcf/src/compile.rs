@@ -1,0 +1,422 @@
+//! Typed MJCF tree → [`Model`], following MuJoCo's compiler (`user_model.cc`, `user_objects.cc`):
+//! default classes with inheritance and `childclass`, angle units, orientation specifiers,
+//! `<frame>` composition, `autolimits`, joint addresses and `qpos0`.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+use crate::error::Error;
+use crate::math::{orientation_to_quat, z_to_quat};
+use crate::model::{Body, Geom, GeomType, Joint, JointType, Model, Site};
+use crate::source::{Pos, Sources};
+use crate::syntax::{
+    AngleUnit, BodySpec, DefaultSpec, GeomAttrs, GeomSpec, Item, JointAttrs, JointSpec, Limited,
+    Mjcf, Orientation,
+};
+
+/// A default class with its ancestors' attributes merged in.
+#[derive(Debug, Clone, Default)]
+struct Class {
+    joint: JointAttrs,
+    geom: GeomAttrs,
+    site: GeomAttrs,
+}
+
+/// A rigid transform accumulated through `<frame>` elements: `x_parent = pos + quat * x_child`.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    pos: Vector3<f64>,
+    quat: UnitQuaternion<f64>,
+}
+
+impl Frame {
+    const IDENTITY: Frame = Frame {
+        pos: Vector3::new(0.0, 0.0, 0.0),
+        quat: UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(1.0, 0.0, 0.0, 0.0)),
+    };
+
+    fn compose(&self, pos: Vector3<f64>, quat: UnitQuaternion<f64>) -> Frame {
+        Frame { pos: self.pos + self.quat * pos, quat: self.quat * quat }
+    }
+}
+
+pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
+    let mut classes = HashMap::new();
+    flatten_defaults(&mjcf.default, &Class::default(), src, &mut classes)?;
+    let c = &mjcf.compiler;
+    let mut compiler = Compiler {
+        src,
+        classes,
+        angle_scale: if c.angle.unwrap_or(AngleUnit::Degree) == AngleUnit::Degree {
+            PI / 180.0
+        } else {
+            1.0
+        },
+        eulerseq: c.eulerseq.unwrap_or(*b"xyz"),
+        autolimits: c.autolimits.unwrap_or(true),
+        model: Model {
+            name: mjcf.model_name.clone().unwrap_or_default(),
+            nq: 0,
+            nv: 0,
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            geoms: Vec::new(),
+            sites: Vec::new(),
+            qpos0: Vec::new(),
+            dof_joint: Vec::new(),
+            dof_parent: Vec::new(),
+            body_last_dof: Vec::new(),
+        },
+    };
+    let main_class = mjcf.default.class.clone();
+    compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
+    Ok(compiler.model)
+}
+
+fn flatten_defaults(
+    spec: &DefaultSpec,
+    parent: &Class,
+    src: &Sources,
+    out: &mut HashMap<String, Class>,
+) -> Result<(), Error> {
+    let class = Class {
+        joint: merge_joint(&spec.joint, &parent.joint),
+        geom: merge_geom(&spec.geom, &parent.geom),
+        site: merge_geom(&spec.site, &parent.site),
+    };
+    if out.contains_key(&spec.class) {
+        return Err(src.invalid(spec.pos, format!("repeated default class \"{}\"", spec.class)));
+    }
+    for child in &spec.children {
+        flatten_defaults(child, &class, src, out)?;
+    }
+    out.insert(spec.class.clone(), class);
+    Ok(())
+}
+
+fn merge_joint(own: &JointAttrs, base: &JointAttrs) -> JointAttrs {
+    JointAttrs {
+        kind: own.kind.or(base.kind),
+        pos: own.pos.or(base.pos),
+        axis: own.axis.or(base.axis),
+        range: own.range.or(base.range),
+        limited: own.limited.or(base.limited),
+        reference: own.reference.or(base.reference),
+    }
+}
+
+fn merge_geom(own: &GeomAttrs, base: &GeomAttrs) -> GeomAttrs {
+    // A shorter `size` overwrites only its leading entries (MuJoCo reads into the default array).
+    let size = match (&own.size, &base.size) {
+        (Some(o), Some(b)) if o.len() < b.len() => {
+            let mut merged = b.clone();
+            merged[..o.len()].copy_from_slice(o);
+            Some(merged)
+        }
+        (o, b) => o.clone().or_else(|| b.clone()),
+    };
+    GeomAttrs {
+        kind: own.kind.or(base.kind),
+        size,
+        pos: own.pos.or(base.pos),
+        orientation: own.orientation.or(base.orientation),
+        fromto: own.fromto.or(base.fromto),
+        mesh: own.mesh.clone().or_else(|| base.mesh.clone()),
+    }
+}
+
+/// What a body owns directly (also through `<frame>`s): joints, geoms, sites, child bodies.
+struct Contents<'a> {
+    joints: Vec<(&'a JointSpec, Option<Pos>, &'a str)>,
+    geoms: Vec<(&'a GeomSpec, Frame, &'a str)>,
+    sites: Vec<(&'a GeomSpec, Frame, &'a str)>,
+    bodies: Vec<(&'a BodySpec, Frame, &'a str)>,
+}
+
+struct Compiler<'a> {
+    src: &'a Sources,
+    classes: HashMap<String, Class>,
+    angle_scale: f64,
+    eulerseq: [u8; 3],
+    autolimits: bool,
+    model: Model,
+}
+
+impl<'a> Compiler<'a> {
+    /// Adds `spec` as a body with the given parent and placement, then its subtree (depth-first,
+    /// MuJoCo's body order).
+    fn body(
+        &mut self,
+        spec: &'a BodySpec,
+        parent: usize,
+        placement: Frame,
+        class: &'a str,
+    ) -> Result<(), Error> {
+        let id = self.model.bodies.len();
+        let class = self.childclass(spec, class)?;
+        let mut contents = Contents {
+            joints: Vec::new(),
+            geoms: Vec::new(),
+            sites: Vec::new(),
+            bodies: Vec::new(),
+        };
+        self.collect(&spec.items, Frame::IDENTITY, class, None, &mut contents)?;
+        self.model.bodies.push(Body {
+            name: spec.name.clone().unwrap_or_default(),
+            parent,
+            pos: placement.pos,
+            quat: placement.quat,
+            jnt_adr: self.model.joints.len(),
+            jnt_num: contents.joints.len(),
+            dof_adr: self.model.nv,
+            dof_num: 0,
+        });
+        let parent_last_dof = if id == 0 { None } else { self.model.body_last_dof[parent] };
+        self.model.body_last_dof.push(parent_last_dof);
+        for (joint, frame_pos, class) in &contents.joints {
+            if let Some(at) = frame_pos {
+                return Err(self.src.unsupported(*at, "joint inside <frame>"));
+            }
+            self.joint(joint, id, class)?;
+        }
+        for (geom, frame, class) in &contents.geoms {
+            let geom = self.geom(geom, id, *frame, class, false)?;
+            self.model.geoms.push(geom);
+        }
+        for (site, frame, class) in &contents.sites {
+            let geom = self.geom(site, id, *frame, class, true)?;
+            let Geom { name, body, kind, size, pos, quat, .. } = geom;
+            self.model.sites.push(Site { name, body, kind, size, pos, quat });
+        }
+        for (child, frame, class) in contents.bodies {
+            let pos = Vector3::from(child.translation.unwrap_or_default());
+            let quat = self.orientation(child.orientation.as_ref())?;
+            self.body(child, id, frame.compose(pos, quat), class)?;
+        }
+        Ok(())
+    }
+
+    fn childclass(&self, spec: &'a BodySpec, inherited: &'a str) -> Result<&'a str, Error> {
+        match &spec.childclass {
+            Some((name, at)) if !self.classes.contains_key(name) => {
+                Err(self.src.invalid(*at, format!("unknown default class \"{name}\"")))
+            }
+            Some((name, _)) => Ok(name),
+            None => Ok(inherited),
+        }
+    }
+
+    fn collect(
+        &self,
+        items: &'a [Item],
+        frame: Frame,
+        class: &'a str,
+        in_frame: Option<Pos>,
+        out: &mut Contents<'a>,
+    ) -> Result<(), Error> {
+        for item in items {
+            match item {
+                Item::Joint(j) => out.joints.push((j, in_frame, class)),
+                Item::Geom(g) => out.geoms.push((g, frame, class)),
+                Item::Site(s) => out.sites.push((s, frame, class)),
+                Item::Body(b) => out.bodies.push((b, frame, class)),
+                Item::Frame(f) => {
+                    let pos = Vector3::from(f.translation.unwrap_or_default());
+                    let quat = self.orientation(f.orientation.as_ref())?;
+                    let inner = self.childclass(f, class)?;
+                    self.collect(&f.items, frame.compose(pos, quat), inner, Some(f.pos), out)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn class(&self, explicit: Option<&(String, Pos)>, inherited: &str) -> Result<&Class, Error> {
+        let (name, at) = match explicit {
+            Some((name, at)) => (name.as_str(), Some(*at)),
+            None => (inherited, None),
+        };
+        self.classes.get(name).ok_or_else(|| match at {
+            Some(at) => self.src.invalid(at, format!("unknown default class \"{name}\"")),
+            None => Error::Model {
+                file: self.src.main_name(),
+                message: format!("unknown default class \"{name}\""),
+            },
+        })
+    }
+
+    fn orientation(&self, o: Option<&(Orientation, Pos)>) -> Result<UnitQuaternion<f64>, Error> {
+        match o {
+            None => Ok(UnitQuaternion::identity()),
+            Some((o, at)) => {
+                orientation_to_quat(o, self.angle_scale, self.eulerseq).ok_or_else(|| {
+                    self.src.invalid(*at, "degenerate orientation (zero quaternion or axis)")
+                })
+            }
+        }
+    }
+
+    fn joint(&mut self, spec: &JointSpec, body: usize, class: &str) -> Result<(), Error> {
+        let attrs = if spec.is_freejoint {
+            spec.attrs.clone()
+        } else {
+            merge_joint(&spec.attrs, &self.class(spec.class.as_ref(), class)?.joint)
+        };
+        let kind = attrs.kind.unwrap_or(JointType::Hinge);
+        let parent = self.model.bodies[body].parent;
+        if kind == JointType::Free && (parent != 0 || self.model.bodies[body].jnt_num != 1) {
+            let what = if parent != 0 {
+                "a free joint in a body that is not a child of the world"
+            } else {
+                "a free joint together with other joints in one body"
+            };
+            return Err(self.src.unsupported(spec.pos, what));
+        }
+        let axis = match kind {
+            JointType::Hinge | JointType::Slide => {
+                let a = Vector3::from(attrs.axis.unwrap_or([0.0, 0.0, 1.0]));
+                let n = a.norm();
+                if n < 1e-10 {
+                    return Err(self.src.invalid(spec.pos, "joint axis has zero length"));
+                }
+                a / n
+            }
+            JointType::Ball | JointType::Free => Vector3::z(),
+        };
+        let range = self.joint_range(spec, &attrs, kind)?;
+        let joint = Joint {
+            name: spec.name.clone().unwrap_or_default(),
+            kind,
+            body,
+            qpos_adr: self.model.nq,
+            dof_adr: self.model.nv,
+            range,
+            axis,
+            pos: Vector3::from(attrs.pos.unwrap_or_default()),
+        };
+        self.push_qpos0(&joint, &attrs);
+        self.push_dofs(&joint);
+        self.model.joints.push(joint);
+        Ok(())
+    }
+
+    /// `limited` with `autolimits` (MuJoCo's `checklimited`), angle units, range order.
+    fn joint_range(
+        &self,
+        spec: &JointSpec,
+        attrs: &JointAttrs,
+        kind: JointType,
+    ) -> Result<Option<[f64; 2]>, Error> {
+        if kind == JointType::Free {
+            return Ok(None);
+        }
+        let raw = attrs.range.unwrap_or([0.0, 0.0]);
+        let has_range = raw != [0.0, 0.0];
+        let limited = match attrs.limited.unwrap_or(Limited::Auto) {
+            Limited::True => true,
+            Limited::False => false,
+            Limited::Auto if has_range && !self.autolimits => {
+                return Err(self.src.invalid(
+                    spec.pos,
+                    "joint has a range but no limited attribute and autolimits is false; set limited or autolimits",
+                ));
+            }
+            Limited::Auto => has_range,
+        };
+        if !limited {
+            return Ok(None);
+        }
+        let scale = if kind == JointType::Slide { 1.0 } else { self.angle_scale };
+        let range = [raw[0] * scale, raw[1] * scale];
+        if kind != JointType::Ball && range[0] >= range[1] {
+            return Err(self.src.invalid(spec.pos, "joint range[0] must be smaller than range[1]"));
+        }
+        Ok(Some(range))
+    }
+
+    fn push_qpos0(&mut self, joint: &Joint, attrs: &JointAttrs) {
+        match joint.kind {
+            JointType::Free => {
+                let b = &self.model.bodies[joint.body];
+                self.model.qpos0.extend([b.pos.x, b.pos.y, b.pos.z]);
+                self.model.qpos0.extend([b.quat.w, b.quat.i, b.quat.j, b.quat.k]);
+            }
+            JointType::Ball => self.model.qpos0.extend([1.0, 0.0, 0.0, 0.0]),
+            JointType::Hinge => {
+                self.model.qpos0.push(attrs.reference.unwrap_or(0.0) * self.angle_scale)
+            }
+            JointType::Slide => self.model.qpos0.push(attrs.reference.unwrap_or(0.0)),
+        }
+        self.model.nq += joint.kind.nq();
+    }
+
+    fn push_dofs(&mut self, joint: &Joint) {
+        let joint_id = self.model.joints.len();
+        for _ in 0..joint.kind.nv() {
+            let dof = self.model.nv;
+            self.model.dof_parent.push(self.model.body_last_dof[joint.body]);
+            self.model.dof_joint.push(joint_id);
+            self.model.body_last_dof[joint.body] = Some(dof);
+            self.model.bodies[joint.body].dof_num += 1;
+            self.model.nv += 1;
+        }
+    }
+
+    fn geom(
+        &self,
+        spec: &GeomSpec,
+        body: usize,
+        frame: Frame,
+        class: &str,
+        is_site: bool,
+    ) -> Result<Geom, Error> {
+        let class = self.class(spec.class.as_ref(), class)?;
+        let attrs = merge_geom(&spec.attrs, if is_site { &class.site } else { &class.geom });
+        let kind = attrs.kind.unwrap_or(GeomType::Sphere);
+        let mut size = [0.0; 3];
+        let default_size: &[f64] = if is_site { &[0.005, 0.005, 0.005] } else { &[0.0] };
+        let given = attrs.size.as_deref().unwrap_or(default_size);
+        size[..given.len()].copy_from_slice(given);
+        let (pos, quat) = match attrs.fromto {
+            Some(ft) => {
+                let (from, to) =
+                    (Vector3::new(ft[0], ft[1], ft[2]), Vector3::new(ft[3], ft[4], ft[5]));
+                if !matches!(
+                    kind,
+                    GeomType::Capsule | GeomType::Cylinder | GeomType::Box | GeomType::Ellipsoid
+                ) {
+                    return Err(self
+                        .src
+                        .invalid(spec.pos, "fromto needs a capsule, cylinder, box or ellipsoid"));
+                }
+                let dir = to - from;
+                if dir.norm() < 1e-10 {
+                    return Err(self.src.invalid(spec.pos, "fromto with coincident end points"));
+                }
+                let half = dir.norm() / 2.0;
+                match kind {
+                    GeomType::Capsule | GeomType::Cylinder => size[1] = half,
+                    _ => size[2] = half,
+                }
+                // MuJoCo aligns the geom's z axis with from − to (mjCGeom's fromto rule).
+                ((from + to) / 2.0, z_to_quat(&(-dir).normalize()))
+            }
+            None => (
+                Vector3::from(attrs.pos.unwrap_or_default()),
+                self.orientation(attrs.orientation.as_ref())?,
+            ),
+        };
+        let placed = frame.compose(pos, quat);
+        Ok(Geom {
+            name: spec.name.clone().unwrap_or_default(),
+            body,
+            kind,
+            size,
+            pos: placed.pos,
+            quat: placed.quat,
+            mesh: attrs.mesh.filter(|_| kind == GeomType::Mesh),
+        })
+    }
+}

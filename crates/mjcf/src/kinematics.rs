@@ -1,0 +1,262 @@
+//! Forward kinematics, Jacobians and position integration: MuJoCo's `mj_kinematics`,
+//! `mj_jac`/`mj_jacBody` and `mj_integratePos` (engine_core_smooth.c, engine_support.c),
+//! analytic and allocation-free.
+
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+
+use crate::math::axis_angle;
+use crate::model::{JointType, Model};
+
+/// Results of [`Model::kinematics`] for one configuration (MuJoCo's `mjData` subset).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Data {
+    /// World position of each body frame.
+    pub xpos: Vec<Vector3<f64>>,
+    /// World orientation of each body frame.
+    pub xquat: Vec<UnitQuaternion<f64>>,
+    /// `xquat` as rotation matrices.
+    pub xmat: Vec<Matrix3<f64>>,
+    /// World position of each joint anchor.
+    pub xanchor: Vec<Vector3<f64>>,
+    /// World direction of each joint axis (free joint: the model axis, as in MuJoCo).
+    pub xaxis: Vec<Vector3<f64>>,
+    pub geom_xpos: Vec<Vector3<f64>>,
+    pub geom_xmat: Vec<Matrix3<f64>>,
+    pub site_xpos: Vec<Vector3<f64>>,
+    pub site_xmat: Vec<Matrix3<f64>>,
+    /// Per dof: world rotation axis (angular dofs) or translation direction (linear dofs).
+    dof_axis: Vec<Vector3<f64>>,
+    /// Per dof: whether it translates (slide, free linear) rather than rotates.
+    dof_linear: Vec<bool>,
+    /// Per dof: the joint anchor in the world (rotation centre of angular dofs).
+    dof_anchor: Vec<Vector3<f64>>,
+}
+
+impl Data {
+    /// Workspace sized for `model`, at the identity (all zeros; call [`Model::kinematics`]).
+    #[must_use]
+    pub fn new(model: &Model) -> Data {
+        let nb = model.bodies.len();
+        let nj = model.joints.len();
+        Data {
+            xpos: vec![Vector3::zeros(); nb],
+            xquat: vec![UnitQuaternion::identity(); nb],
+            xmat: vec![Matrix3::identity(); nb],
+            xanchor: vec![Vector3::zeros(); nj],
+            xaxis: vec![Vector3::zeros(); nj],
+            geom_xpos: vec![Vector3::zeros(); model.geoms.len()],
+            geom_xmat: vec![Matrix3::identity(); model.geoms.len()],
+            site_xpos: vec![Vector3::zeros(); model.sites.len()],
+            site_xmat: vec![Matrix3::identity(); model.sites.len()],
+            dof_axis: vec![Vector3::zeros(); model.nv],
+            dof_linear: (0..model.nv)
+                .map(|d| model.joints[model.dof_joint[d]].kind == JointType::Slide)
+                .collect(),
+            dof_anchor: vec![Vector3::zeros(); model.nv],
+        }
+    }
+}
+
+/// Unit quaternion from four numbers the way `mju_normalize4` does (identity when ~0).
+#[inline]
+fn quat_from_slice(q: &[f64]) -> UnitQuaternion<f64> {
+    let q = Quaternion::new(q[0], q[1], q[2], q[3]);
+    let n = q.norm();
+    if n < 1e-15 {
+        UnitQuaternion::identity()
+    } else {
+        UnitQuaternion::new_unchecked(q / n)
+    }
+}
+
+#[inline]
+fn renormalize(q: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
+    let n = q.norm();
+    UnitQuaternion::new_unchecked(q.into_inner() / n)
+}
+
+impl Model {
+    /// Forward kinematics (`mj_kinematics`): world poses of all bodies, geoms and sites for
+    /// `qpos` (free and ball joints as w-first quaternions). Body `b`: `xpos = xpos[parent] +
+    /// R[parent] pos[b]`, `xquat = xquat[parent] quat[b]`, then each joint in turn: free sets
+    /// the pose from `qpos`, hinge rotates by `q - qpos0` about its anchor, ball by its
+    /// quaternion, slide translates by `q - qpos0` along its axis.
+    ///
+    /// A `qpos` shorter than `nq` leaves `data` unchanged (library code does not panic).
+    pub fn kinematics(&self, qpos: &[f64], data: &mut Data) {
+        if qpos.len() < self.nq
+            || data.xpos.len() != self.bodies.len()
+            || data.dof_axis.len() != self.nv
+        {
+            return;
+        }
+        for (i, body) in self.bodies.iter().enumerate().skip(1) {
+            let (mut xpos, mut xquat) = (
+                data.xpos[body.parent] + data.xmat[body.parent] * body.pos,
+                data.xquat[body.parent] * body.quat,
+            );
+            for j in body.jnt_adr..body.jnt_adr + body.jnt_num {
+                let joint = &self.joints[j];
+                let a = joint.qpos_adr;
+                if joint.kind == JointType::Free {
+                    xpos = Vector3::new(qpos[a], qpos[a + 1], qpos[a + 2]);
+                    xquat = quat_from_slice(&qpos[a + 3..a + 7]);
+                    data.xanchor[j] = xpos;
+                    data.xaxis[j] = joint.axis;
+                    continue;
+                }
+                let xaxis = xquat * joint.axis;
+                let xanchor = xquat * joint.pos + xpos;
+                match joint.kind {
+                    JointType::Slide => xpos += xaxis * (qpos[a] - self.qpos0[a]),
+                    JointType::Hinge | JointType::Ball => {
+                        let local = if joint.kind == JointType::Ball {
+                            quat_from_slice(&qpos[a..a + 4])
+                        } else {
+                            axis_angle(&joint.axis, qpos[a] - self.qpos0[a])
+                        };
+                        xquat *= local;
+                        xpos = xanchor - xquat * joint.pos;
+                    }
+                    JointType::Free => {}
+                }
+                data.xanchor[j] = xanchor;
+                data.xaxis[j] = xaxis;
+            }
+            let xquat = renormalize(xquat);
+            data.xpos[i] = xpos;
+            data.xquat[i] = xquat;
+            data.xmat[i] = *xquat.to_rotation_matrix().matrix();
+        }
+        self.place_geoms_and_sites(data);
+        self.dof_frames(data);
+    }
+
+    fn place_geoms_and_sites(&self, data: &mut Data) {
+        for (g, geom) in self.geoms.iter().enumerate() {
+            let (p, r) = (data.xpos[geom.body], data.xmat[geom.body]);
+            data.geom_xpos[g] = p + r * geom.pos;
+            data.geom_xmat[g] = r * geom.quat.to_rotation_matrix().matrix();
+        }
+        for (s, site) in self.sites.iter().enumerate() {
+            let (p, r) = (data.xpos[site.body], data.xmat[site.body]);
+            data.site_xpos[s] = p + r * site.pos;
+            data.site_xmat[s] = r * site.quat.to_rotation_matrix().matrix();
+        }
+    }
+
+    /// World axis and anchor of every dof, as MuJoCo's `cdof`: hinge and slide use the joint
+    /// axis; ball and the free joint's rotation use the columns of the body's `xmat` ("assume
+    /// no subsequent rotations"); the free joint's translation uses the world axes.
+    fn dof_frames(&self, data: &mut Data) {
+        for (j, joint) in self.joints.iter().enumerate() {
+            let d = joint.dof_adr;
+            let (anchor, r) = (data.xanchor[j], data.xmat[joint.body]);
+            match joint.kind {
+                JointType::Hinge | JointType::Slide => {
+                    data.dof_axis[d] = data.xaxis[j];
+                    data.dof_anchor[d] = anchor;
+                }
+                JointType::Ball => {
+                    for k in 0..3 {
+                        data.dof_axis[d + k] = r.column(k).into();
+                        data.dof_anchor[d + k] = anchor;
+                    }
+                }
+                JointType::Free => {
+                    for k in 0..3 {
+                        data.dof_axis[d + k] = Vector3::ith(k, 1.0);
+                        data.dof_linear[d + k] = true;
+                        data.dof_axis[d + 3 + k] = r.column(k).into();
+                        data.dof_anchor[d + 3 + k] = anchor;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Translational and rotational Jacobian (`mj_jacBody`) of the origin of `body`, each
+    /// 3 × nv row-major in the world frame. Uses `data` from [`Model::kinematics`].
+    pub fn jac_body(&self, data: &Data, body: usize, jacp: &mut [f64], jacr: &mut [f64]) {
+        if let Some(point) = data.xpos.get(body).copied() {
+            self.jac(data, body, &point, jacp, jacr);
+        }
+    }
+
+    /// Jacobians (`mj_jac`) of the world point `point` moving with `body`: column `d` of
+    /// `jacr` is the world rotation axis of dof `d` (0 for translations), column `d` of `jacp`
+    /// is `axis × (point − anchor)` for rotations and the direction for translations; dofs not
+    /// on the body's path to the world give zero columns. Slices shorter than `3 nv` or an
+    /// unknown body leave them unchanged.
+    pub fn jac(
+        &self,
+        data: &Data,
+        body: usize,
+        point: &Vector3<f64>,
+        jacp: &mut [f64],
+        jacr: &mut [f64],
+    ) {
+        let nv = self.nv;
+        if body >= self.bodies.len()
+            || jacp.len() < 3 * nv
+            || jacr.len() < 3 * nv
+            || data.dof_axis.len() != nv
+        {
+            return;
+        }
+        jacp[..3 * nv].fill(0.0);
+        jacr[..3 * nv].fill(0.0);
+        for d in self.body_dofs(body) {
+            let axis = data.dof_axis[d];
+            if data.dof_linear[d] {
+                for r in 0..3 {
+                    jacp[r * nv + d] = axis[r];
+                }
+            } else {
+                let v = axis.cross(&(point - data.dof_anchor[d]));
+                for r in 0..3 {
+                    jacp[r * nv + d] = v[r];
+                    jacr[r * nv + d] = axis[r];
+                }
+            }
+        }
+    }
+
+    /// `mj_integratePos`: `qpos ← qpos ⊕ qvel dt`. Hinge and slide add; ball and the free
+    /// joint's rotation apply the quaternion exponential of the body-frame angular velocity
+    /// (`mju_quatIntegrate`); the free joint's translation adds the world-frame velocity.
+    /// Slices shorter than `nq`/`nv` leave `qpos` unchanged.
+    pub fn integrate_pos(&self, qpos: &mut [f64], qvel: &[f64], dt: f64) {
+        if qpos.len() < self.nq || qvel.len() < self.nv {
+            return;
+        }
+        for joint in &self.joints {
+            let (mut a, mut v) = (joint.qpos_adr, joint.dof_adr);
+            match joint.kind {
+                JointType::Hinge | JointType::Slide => qpos[a] += dt * qvel[v],
+                JointType::Ball | JointType::Free => {
+                    if joint.kind == JointType::Free {
+                        for k in 0..3 {
+                            qpos[a + k] += dt * qvel[v + k];
+                        }
+                        a += 3;
+                        v += 3;
+                    }
+                    let q = quat_integrate(
+                        &qpos[a..a + 4],
+                        &Vector3::new(qvel[v], qvel[v + 1], qvel[v + 2]),
+                        dt,
+                    );
+                    qpos[a..a + 4].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+                }
+            }
+        }
+    }
+}
+
+/// `mju_quatIntegrate`: `q ← normalize(q) · exp(ω dt / 2)` with ω in the rotated frame.
+fn quat_integrate(q: &[f64], omega: &Vector3<f64>, dt: f64) -> UnitQuaternion<f64> {
+    let n = omega.norm();
+    let rot = if n < 1e-15 { UnitQuaternion::identity() } else { axis_angle(&(omega / n), dt * n) };
+    quat_from_slice(q) * rot
+}

@@ -1,0 +1,195 @@
+//! The compiled kinematic model: MuJoCo's `mjModel` restricted to what kinematics needs, in
+//! MuJoCo's order (bodies depth-first, parents first; joints, geoms and sites by body).
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// Joint types (MuJoCo's `mjtJoint`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum JointType {
+    /// 7 qpos (x, y, z, qw, qx, qy, qz), 6 dofs (linear in the world frame, angular in the body frame).
+    Free,
+    /// 4 qpos (unit quaternion, w first), 3 dofs (angular in the body frame).
+    Ball,
+    /// 1 qpos, 1 dof: translation along `axis`.
+    Slide,
+    /// 1 qpos, 1 dof: rotation about `axis` through `pos`.
+    Hinge,
+}
+
+impl JointType {
+    /// Number of `qpos` entries.
+    #[must_use]
+    pub const fn nq(self) -> usize {
+        match self {
+            JointType::Free => 7,
+            JointType::Ball => 4,
+            JointType::Slide | JointType::Hinge => 1,
+        }
+    }
+
+    /// Number of degrees of freedom (`qvel` entries).
+    #[must_use]
+    pub const fn nv(self) -> usize {
+        match self {
+            JointType::Free => 6,
+            JointType::Ball => 3,
+            JointType::Slide | JointType::Hinge => 1,
+        }
+    }
+
+    /// MuJoCo's keyword.
+    #[must_use]
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            JointType::Free => "free",
+            JointType::Ball => "ball",
+            JointType::Slide => "slide",
+            JointType::Hinge => "hinge",
+        }
+    }
+}
+
+/// Geom types (MuJoCo's `mjtGeom`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum GeomType {
+    Plane,
+    Hfield,
+    Sphere,
+    Capsule,
+    Ellipsoid,
+    Cylinder,
+    Box,
+    Mesh,
+    Sdf,
+}
+
+/// A body. `pos`/`quat` place its frame in its parent's frame (MuJoCo `body_pos`/`body_quat`,
+/// `<frame>` elements already folded in). `bodies[0]` is the world.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// Empty when the MJCF gives none.
+    pub name: String,
+    /// Parent body id (`0` for the world itself).
+    pub parent: usize,
+    pub pos: Vector3<f64>,
+    pub quat: UnitQuaternion<f64>,
+    /// First joint of this body (joints of a body are contiguous).
+    pub jnt_adr: usize,
+    /// Number of joints of this body.
+    pub jnt_num: usize,
+    /// First dof of this body.
+    pub dof_adr: usize,
+    /// Number of dofs of this body.
+    pub dof_num: usize,
+}
+
+/// A joint, in the frame of its body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Empty when the MJCF gives none.
+    pub name: String,
+    pub kind: JointType,
+    pub body: usize,
+    pub qpos_adr: usize,
+    pub dof_adr: usize,
+    /// `Some` iff the joint is limited; radians for hinge and ball (ball: `[0, max angle]`),
+    /// metres for slide.
+    pub range: Option<[f64; 2]>,
+    /// Unit axis in the body frame (hinge, slide; `(0, 0, 1)` for ball and free).
+    pub axis: Vector3<f64>,
+    /// Anchor in the body frame.
+    pub pos: Vector3<f64>,
+}
+
+/// A geom, placed in its body's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Geom {
+    pub name: String,
+    pub body: usize,
+    pub kind: GeomType,
+    /// MuJoCo `geom_size` (unused entries 0; capsule/cylinder `fromto` sets the half length).
+    pub size: [f64; 3],
+    pub pos: Vector3<f64>,
+    pub quat: UnitQuaternion<f64>,
+    /// Mesh asset name of a mesh geom. Its pose is kept as written: MuJoCo additionally moves
+    /// mesh geoms to the mesh's inertial frame, which needs the mesh file and is not done here.
+    pub mesh: Option<String>,
+}
+
+/// A site, placed in its body's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Site {
+    pub name: String,
+    pub body: usize,
+    pub kind: GeomType,
+    pub size: [f64; 3],
+    pub pos: Vector3<f64>,
+    pub quat: UnitQuaternion<f64>,
+}
+
+/// The kinematic model. Build it with [`Model::from_file`] or [`Model::from_xml_str`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// `<mujoco model="...">`, empty when absent.
+    pub name: String,
+    /// Number of generalised coordinates (`qpos`).
+    pub nq: usize,
+    /// Number of degrees of freedom (`qvel`).
+    pub nv: usize,
+    pub bodies: Vec<Body>,
+    pub joints: Vec<Joint>,
+    pub geoms: Vec<Geom>,
+    pub sites: Vec<Site>,
+    /// Default configuration (free: body pos and quat; ball: identity; hinge, slide: `ref`).
+    pub qpos0: Vec<f64>,
+    /// Joint of each dof.
+    pub(crate) dof_joint: Vec<usize>,
+    /// Previous dof on the path to the world (MuJoCo `dof_parentid`).
+    pub(crate) dof_parent: Vec<Option<usize>>,
+    /// Last dof on the path from a body to the world (its own or an ancestor's).
+    pub(crate) body_last_dof: Vec<Option<usize>>,
+}
+
+impl Model {
+    /// Id of the body called `name`.
+    #[must_use]
+    pub fn body_id(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Id of the joint called `name`.
+    #[must_use]
+    pub fn joint_id(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| !j.name.is_empty() && j.name == name)
+    }
+
+    /// Id of the geom called `name`.
+    #[must_use]
+    pub fn geom_id(&self, name: &str) -> Option<usize> {
+        self.geoms.iter().position(|g| !g.name.is_empty() && g.name == name)
+    }
+
+    /// Id of the site called `name`.
+    #[must_use]
+    pub fn site_id(&self, name: &str) -> Option<usize> {
+        self.sites.iter().position(|s| !s.name.is_empty() && s.name == name)
+    }
+
+    /// Number of bodies including the world.
+    #[must_use]
+    pub fn nbody(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// The dofs that move `body` (MuJoCo's dof ancestor chain), from the body towards the world.
+    pub fn body_dofs(&self, body: usize) -> impl Iterator<Item = usize> + '_ {
+        let start = self.body_last_dof.get(body).copied().flatten();
+        std::iter::successors(start, |&d| self.dof_parent[d])
+    }
+
+    /// The joint a dof belongs to.
+    #[must_use]
+    pub fn dof_joint(&self, dof: usize) -> usize {
+        self.dof_joint[dof]
+    }
+}

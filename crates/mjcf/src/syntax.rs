@@ -1,0 +1,453 @@
+//! The typed MJCF tree: what the file says, attribute by attribute, before any default,
+//! class, unit or frame is applied (that is `compile`'s job). Only the parts that matter for
+//! kinematics are kept; elements that cannot change a body pose (actuators, sensors, assets,
+//! contact, visual, ...) are skipped, and elements that would change one but are not
+//! implemented are an [`Error::Unsupported`](crate::Error::Unsupported).
+
+use crate::error::Error;
+use crate::model::{GeomType, JointType};
+use crate::source::{Attr, Element, Pos, Sources};
+
+/// `angle` of `<compiler>`: the unit of angles in the file (MuJoCo's default: degrees).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum AngleUnit {
+    Degree,
+    Radian,
+}
+
+#[derive(Debug, Clone, Default)]
+pub(crate) struct CompilerSpec {
+    pub angle: Option<AngleUnit>,
+    pub eulerseq: Option<[u8; 3]>,
+    pub autolimits: Option<bool>,
+}
+
+/// One orientation specifier as written (units and sequence resolved by `compile`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Orientation {
+    Quat([f64; 4]),
+    AxisAngle([f64; 4]),
+    Euler([f64; 3]),
+    XyAxes([f64; 6]),
+    ZAxis([f64; 3]),
+}
+
+/// `limited="false|true|auto"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Limited {
+    False,
+    True,
+    Auto,
+}
+
+/// Joint attributes that a `<default>` can set, each `None` when not written.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct JointAttrs {
+    pub kind: Option<JointType>,
+    pub pos: Option<[f64; 3]>,
+    pub axis: Option<[f64; 3]>,
+    pub range: Option<[f64; 2]>,
+    pub limited: Option<Limited>,
+    pub reference: Option<f64>,
+}
+
+/// Geom and site attributes that a `<default>` can set.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct GeomAttrs {
+    pub kind: Option<GeomType>,
+    pub size: Option<Vec<f64>>,
+    pub pos: Option<[f64; 3]>,
+    pub orientation: Option<(Orientation, Pos)>,
+    pub fromto: Option<[f64; 6]>,
+    pub mesh: Option<String>,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct DefaultSpec {
+    pub class: String,
+    pub joint: JointAttrs,
+    pub geom: GeomAttrs,
+    pub site: GeomAttrs,
+    pub children: Vec<DefaultSpec>,
+    pub pos: Pos,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct JointSpec {
+    pub name: Option<String>,
+    pub class: Option<(String, Pos)>,
+    pub attrs: JointAttrs,
+    /// `<freejoint>` (ignores defaults).
+    pub is_freejoint: bool,
+    pub pos: Pos,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct GeomSpec {
+    pub name: Option<String>,
+    pub class: Option<(String, Pos)>,
+    pub attrs: GeomAttrs,
+    pub pos: Pos,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) enum Item {
+    Joint(JointSpec),
+    Geom(GeomSpec),
+    Site(GeomSpec),
+    Body(BodySpec),
+    Frame(BodySpec),
+}
+
+/// A `<body>`, a `<frame>` or the `<worldbody>` (name `world`).
+#[derive(Debug, Clone)]
+pub(crate) struct BodySpec {
+    pub name: Option<String>,
+    pub childclass: Option<(String, Pos)>,
+    pub translation: Option<[f64; 3]>,
+    pub orientation: Option<(Orientation, Pos)>,
+    pub items: Vec<Item>,
+    pub pos: Pos,
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct Mjcf {
+    pub model_name: Option<String>,
+    pub compiler: CompilerSpec,
+    pub default: DefaultSpec,
+    pub worldbody: BodySpec,
+}
+
+/// Top-level sections that cannot change body poses: skipped.
+const IGNORED_SECTIONS: &[&str] = &[
+    "option",
+    "size",
+    "visual",
+    "statistic",
+    "asset",
+    "contact",
+    "equality",
+    "tendon",
+    "actuator",
+    "sensor",
+    "keyframe",
+    "extension",
+    "custom",
+    "deformable",
+];
+
+/// Elements inside bodies that cannot change body poses: skipped.
+const IGNORED_IN_BODY: &[&str] = &["inertial", "camera", "light", "plugin"];
+
+pub(crate) fn parse(root: &Element, src: &Sources) -> Result<Mjcf, Error> {
+    let mut mjcf = Mjcf {
+        model_name: root.attr("model").map(|a| a.value.clone()),
+        compiler: CompilerSpec::default(),
+        default: DefaultSpec {
+            class: "main".into(),
+            joint: JointAttrs::default(),
+            geom: GeomAttrs::default(),
+            site: GeomAttrs::default(),
+            children: Vec::new(),
+            pos: root.pos,
+        },
+        worldbody: BodySpec {
+            name: Some("world".into()),
+            childclass: None,
+            translation: None,
+            orientation: None,
+            items: Vec::new(),
+            pos: root.pos,
+        },
+    };
+    for el in &root.children {
+        match el.name.as_str() {
+            "compiler" => parse_compiler(el, src, &mut mjcf.compiler)?,
+            "default" => parse_top_default(el, src, &mut mjcf.default)?,
+            "worldbody" => {
+                for child in &el.children {
+                    if let Some(item) = parse_item(child, src, true)? {
+                        mjcf.worldbody.items.push(item);
+                    }
+                }
+            }
+            name if IGNORED_SECTIONS.contains(&name) => {}
+            other => return Err(src.unsupported(el.pos, format!("element <{other}> in <mujoco>"))),
+        }
+    }
+    Ok(mjcf)
+}
+
+fn parse_compiler(el: &Element, src: &Sources, c: &mut CompilerSpec) -> Result<(), Error> {
+    for a in &el.attrs {
+        match a.name.as_str() {
+            "angle" => {
+                c.angle = Some(keyword(
+                    a,
+                    src,
+                    &[("degree", AngleUnit::Degree), ("radian", AngleUnit::Radian)],
+                )?)
+            }
+            "eulerseq" => c.eulerseq = Some(eulerseq(a, src)?),
+            "autolimits" => c.autolimits = Some(boolean(a, src)?),
+            "fusestatic" | "alignfree" if boolean(a, src)? => {
+                return Err(src.unsupported(
+                    a.pos,
+                    format!("<compiler {}=\"true\"> (changes the body tree)", a.name),
+                ));
+            }
+            "coordinate" => {
+                return Err(src.unsupported(a.pos, "<compiler coordinate> (removed from MuJoCo)"))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// The top-level `<default>` is class `main` (its `class` attribute, if any, renames it).
+fn parse_top_default(el: &Element, src: &Sources, main: &mut DefaultSpec) -> Result<(), Error> {
+    let parsed = parse_default(el, src, "main")?;
+    main.class = parsed.class;
+    main.pos = parsed.pos;
+    main.joint = parsed.joint;
+    main.geom = parsed.geom;
+    main.site = parsed.site;
+    main.children.extend(parsed.children);
+    Ok(())
+}
+
+fn parse_default(el: &Element, src: &Sources, fallback_class: &str) -> Result<DefaultSpec, Error> {
+    let class = match el.attr("class") {
+        Some(a) => a.value.clone(),
+        None if fallback_class.is_empty() => {
+            return Err(src.invalid(el.pos, "nested <default> without a class"))
+        }
+        None => fallback_class.to_owned(),
+    };
+    let mut spec = DefaultSpec {
+        class,
+        joint: JointAttrs::default(),
+        geom: GeomAttrs::default(),
+        site: GeomAttrs::default(),
+        children: Vec::new(),
+        pos: el.pos,
+    };
+    for child in &el.children {
+        match child.name.as_str() {
+            "default" => spec.children.push(parse_default(child, src, "")?),
+            "joint" => spec.joint = joint_attrs(child, src)?,
+            "geom" => spec.geom = geom_attrs(child, src)?,
+            "site" => spec.site = geom_attrs(child, src)?,
+            _ => {}
+        }
+    }
+    Ok(spec)
+}
+
+/// A child of `<worldbody>`, `<body>` or `<frame>`; `None` for ignored elements.
+fn parse_item(el: &Element, src: &Sources, in_world: bool) -> Result<Option<Item>, Error> {
+    let item = match el.name.as_str() {
+        "body" => Item::Body(parse_body(el, src)?),
+        "frame" => Item::Frame(parse_body(el, src)?),
+        "joint" | "freejoint" if in_world => {
+            return Err(src.invalid(el.pos, format!("<{}> directly in <worldbody>", el.name)));
+        }
+        "joint" => Item::Joint(parse_joint(el, src)?),
+        "freejoint" => Item::Joint(parse_freejoint(el, src)?),
+        "geom" => Item::Geom(parse_geom(el, src)?),
+        "site" => Item::Site(parse_geom(el, src)?),
+        name if IGNORED_IN_BODY.contains(&name) => return Ok(None),
+        other => return Err(src.unsupported(el.pos, format!("element <{other}> in a body"))),
+    };
+    Ok(Some(item))
+}
+
+fn parse_body(el: &Element, src: &Sources) -> Result<BodySpec, Error> {
+    if let Some(a) = el.attr("mocap").filter(|a| a.value == "true") {
+        return Err(src.unsupported(a.pos, "mocap bodies"));
+    }
+    let mut body = BodySpec {
+        name: el.attr("name").map(|a| a.value.clone()),
+        childclass: el.attr("childclass").map(|a| (a.value.clone(), a.pos)),
+        translation: el.attr("pos").map(|a| floats::<3>(a, src)).transpose()?,
+        orientation: orientation(el, src)?,
+        items: Vec::new(),
+        pos: el.pos,
+    };
+    for child in &el.children {
+        if let Some(item) = parse_item(child, src, false)? {
+            body.items.push(item);
+        }
+    }
+    Ok(body)
+}
+
+fn parse_joint(el: &Element, src: &Sources) -> Result<JointSpec, Error> {
+    Ok(JointSpec {
+        name: el.attr("name").map(|a| a.value.clone()),
+        class: el.attr("class").map(|a| (a.value.clone(), a.pos)),
+        attrs: joint_attrs(el, src)?,
+        is_freejoint: false,
+        pos: el.pos,
+    })
+}
+
+fn parse_freejoint(el: &Element, src: &Sources) -> Result<JointSpec, Error> {
+    if let Some(a) = el.attr("align").filter(|a| a.value == "true") {
+        return Err(src.unsupported(a.pos, "<freejoint align=\"true\"> (moves the body frame)"));
+    }
+    Ok(JointSpec {
+        name: el.attr("name").map(|a| a.value.clone()),
+        class: None,
+        attrs: JointAttrs { kind: Some(JointType::Free), ..JointAttrs::default() },
+        is_freejoint: true,
+        pos: el.pos,
+    })
+}
+
+fn parse_geom(el: &Element, src: &Sources) -> Result<GeomSpec, Error> {
+    Ok(GeomSpec {
+        name: el.attr("name").map(|a| a.value.clone()),
+        class: el.attr("class").map(|a| (a.value.clone(), a.pos)),
+        attrs: geom_attrs(el, src)?,
+        pos: el.pos,
+    })
+}
+
+fn joint_attrs(el: &Element, src: &Sources) -> Result<JointAttrs, Error> {
+    let kinds = [
+        ("free", JointType::Free),
+        ("ball", JointType::Ball),
+        ("slide", JointType::Slide),
+        ("hinge", JointType::Hinge),
+    ];
+    let mut j = JointAttrs::default();
+    for a in &el.attrs {
+        match a.name.as_str() {
+            "type" => j.kind = Some(keyword(a, src, &kinds)?),
+            "pos" => j.pos = Some(floats::<3>(a, src)?),
+            "axis" => j.axis = Some(floats::<3>(a, src)?),
+            "range" => j.range = Some(floats::<2>(a, src)?),
+            "limited" => {
+                let options =
+                    [("false", Limited::False), ("true", Limited::True), ("auto", Limited::Auto)];
+                j.limited = Some(keyword(a, src, &options)?);
+            }
+            "ref" => j.reference = Some(floats::<1>(a, src)?[0]),
+            "align" if a.value == "true" => {
+                return Err(src.unsupported(a.pos, "joint align=\"true\""))
+            }
+            _ => {}
+        }
+    }
+    Ok(j)
+}
+
+fn geom_attrs(el: &Element, src: &Sources) -> Result<GeomAttrs, Error> {
+    let kinds = [
+        ("plane", GeomType::Plane),
+        ("hfield", GeomType::Hfield),
+        ("sphere", GeomType::Sphere),
+        ("capsule", GeomType::Capsule),
+        ("ellipsoid", GeomType::Ellipsoid),
+        ("cylinder", GeomType::Cylinder),
+        ("box", GeomType::Box),
+        ("mesh", GeomType::Mesh),
+        ("sdf", GeomType::Sdf),
+    ];
+    let mut g = GeomAttrs { orientation: orientation(el, src)?, ..GeomAttrs::default() };
+    for a in &el.attrs {
+        match a.name.as_str() {
+            "type" => g.kind = Some(keyword(a, src, &kinds)?),
+            "size" => g.size = Some(float_list(a, src, 1, 3)?),
+            "pos" => g.pos = Some(floats::<3>(a, src)?),
+            "fromto" => g.fromto = Some(floats::<6>(a, src)?),
+            "mesh" => g.mesh = Some(a.value.clone()),
+            _ => {}
+        }
+    }
+    Ok(g)
+}
+
+/// The one orientation attribute of an element, if any (two of them are an error, as in
+/// MuJoCo).
+fn orientation(el: &Element, src: &Sources) -> Result<Option<(Orientation, Pos)>, Error> {
+    let mut found: Option<(Orientation, Pos)> = None;
+    for a in &el.attrs {
+        let o = match a.name.as_str() {
+            "quat" => Orientation::Quat(floats::<4>(a, src)?),
+            "axisangle" => Orientation::AxisAngle(floats::<4>(a, src)?),
+            "euler" => Orientation::Euler(floats::<3>(a, src)?),
+            "xyaxes" => Orientation::XyAxes(floats::<6>(a, src)?),
+            "zaxis" => Orientation::ZAxis(floats::<3>(a, src)?),
+            _ => continue,
+        };
+        if found.is_some() {
+            return Err(
+                src.invalid(a.pos, format!("multiple orientation specifiers on <{}>", el.name))
+            );
+        }
+        found = Some((o, a.pos));
+    }
+    Ok(found)
+}
+
+fn float_list(a: &Attr, src: &Sources, min: usize, max: usize) -> Result<Vec<f64>, Error> {
+    let values: Vec<f64> = a
+        .value
+        .split_ascii_whitespace()
+        .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            src.invalid(
+                a.pos,
+                format!("attribute {}=\"{}\": not a list of numbers", a.name, a.value),
+            )
+        })?;
+    if values.len() < min || values.len() > max {
+        let expected = if min == max { format!("{min}") } else { format!("{min} to {max}") };
+        return Err(src.invalid(
+            a.pos,
+            format!(
+                "attribute {}=\"{}\": expected {expected} numbers, found {}",
+                a.name,
+                a.value,
+                values.len()
+            ),
+        ));
+    }
+    Ok(values)
+}
+
+fn floats<const N: usize>(a: &Attr, src: &Sources) -> Result<[f64; N], Error> {
+    let values = float_list(a, src, N, N)?;
+    let mut out = [0.0; N];
+    out.copy_from_slice(&values);
+    Ok(out)
+}
+
+fn boolean(a: &Attr, src: &Sources) -> Result<bool, Error> {
+    keyword(a, src, &[("false", false), ("true", true)])
+}
+
+fn keyword<T: Copy>(a: &Attr, src: &Sources, options: &[(&str, T)]) -> Result<T, Error> {
+    options.iter().find(|(k, _)| *k == a.value).map(|(_, v)| *v).ok_or_else(|| {
+        let names: Vec<&str> = options.iter().map(|(k, _)| *k).collect();
+        src.invalid(
+            a.pos,
+            format!("attribute {}=\"{}\": expected one of {}", a.name, a.value, names.join(", ")),
+        )
+    })
+}
+
+fn eulerseq(a: &Attr, src: &Sources) -> Result<[u8; 3], Error> {
+    let bytes = a.value.as_bytes();
+    if bytes.len() != 3 || !bytes.iter().all(|b| b"xyzXYZ".contains(b)) {
+        return Err(src.invalid(
+            a.pos,
+            format!("eulerseq=\"{}\": expected three of x, y, z, X, Y, Z", a.value),
+        ));
+    }
+    Ok([bytes[0], bytes[1], bytes[2]])
+}
