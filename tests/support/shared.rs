@@ -20,10 +20,16 @@ pub fn shared_dir() -> Option<PathBuf> {
             } else {
                 dir
             };
-            assert!(dir.join("DESIGN.md").is_file(), "RETARGET_SHARED={} has no DESIGN.md", dir.display());
+            assert!(
+                dir.join("DESIGN.md").is_file(),
+                "RETARGET_SHARED={} has no DESIGN.md",
+                dir.display()
+            );
             Some(dir)
         }
-        None if in_ci => panic!("RETARGET_SHARED is not set under CI: reference-data tests must run"),
+        None if in_ci => {
+            panic!("RETARGET_SHARED is not set under CI: reference-data tests must run")
+        }
         None => {
             eprintln!("note: RETARGET_SHARED is not set; skipping a test on reference data");
             None
