@@ -68,11 +68,18 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
             dof_joint: Vec::new(),
             dof_parent: Vec::new(),
             body_last_dof: Vec::new(),
+            jnt_pos_zero: Vec::new(),
+            geom_mat: Vec::new(),
+            site_mat: Vec::new(),
         },
     };
     let main_class = mjcf.default.class.clone();
     compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
-    Ok(compiler.model)
+    let mut model = compiler.model;
+    model.jnt_pos_zero = model.joints.iter().map(|j| j.pos == Vector3::zeros()).collect();
+    model.geom_mat = model.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
+    model.site_mat = model.sites.iter().map(|s| *s.quat.to_rotation_matrix().matrix()).collect();
+    Ok(model)
 }
 
 fn flatten_defaults(

@@ -91,67 +91,86 @@ impl Model {
             return;
         }
         for (i, body) in self.bodies.iter().enumerate().skip(1) {
-            let (mut xpos, mut xquat) = (
-                data.xpos[body.parent] + data.xmat[body.parent] * body.pos,
-                data.xquat[body.parent] * body.quat,
-            );
-            for j in body.jnt_adr..body.jnt_adr + body.jnt_num {
+            let p = body.parent;
+            let (mut xpos, mut xquat) =
+                (data.xpos[p] + data.xmat[p] * body.pos, data.xquat[p] * body.quat);
+            let last = body.jnt_adr + body.jnt_num;
+            for j in body.jnt_adr..last {
                 let joint = &self.joints[j];
                 let a = joint.qpos_adr;
-                if joint.kind == JointType::Free {
-                    xpos = Vector3::new(qpos[a], qpos[a + 1], qpos[a + 2]);
-                    xquat = quat_from_slice(&qpos[a + 3..a + 7]);
-                    data.xanchor[j] = xpos;
-                    data.xaxis[j] = joint.axis;
-                    continue;
-                }
-                let xaxis = xquat * joint.axis;
-                let xanchor = xquat * joint.pos + xpos;
                 match joint.kind {
-                    JointType::Slide => xpos += xaxis * (qpos[a] - self.qpos0[a]),
+                    JointType::Free => {
+                        xpos = Vector3::new(qpos[a], qpos[a + 1], qpos[a + 2]);
+                        xquat = quat_from_slice(&qpos[a + 3..a + 7]);
+                        data.xanchor[j] = xpos;
+                        data.xaxis[j] = joint.axis;
+                    }
+                    JointType::Slide => {
+                        let xaxis = xquat * joint.axis;
+                        data.xanchor[j] = xquat * joint.pos + xpos;
+                        data.xaxis[j] = xaxis;
+                        xpos += xaxis * (qpos[a] - self.qpos0[a]);
+                    }
                     JointType::Hinge | JointType::Ball => {
                         let local = if joint.kind == JointType::Ball {
                             quat_from_slice(&qpos[a..a + 4])
                         } else {
                             axis_angle(&joint.axis, qpos[a] - self.qpos0[a])
                         };
-                        xquat *= local;
-                        xpos = xanchor - xquat * joint.pos;
+                        // A hinge's axis is fixed by its own rotation: for the body's last
+                        // joint it is taken from the final xmat below (cheaper, same value).
+                        if j + 1 < last || joint.kind == JointType::Ball {
+                            data.xaxis[j] = xquat * joint.axis;
+                        }
+                        if self.jnt_pos_zero[j] {
+                            data.xanchor[j] = xpos;
+                            xquat *= local;
+                        } else {
+                            let xanchor = xquat * joint.pos + xpos;
+                            xquat *= local;
+                            xpos = xanchor - xquat * joint.pos;
+                            data.xanchor[j] = xanchor;
+                        }
                     }
-                    JointType::Free => {}
                 }
-                data.xanchor[j] = xanchor;
-                data.xaxis[j] = xaxis;
             }
             let xquat = renormalize(xquat);
+            let xmat = *xquat.to_rotation_matrix().matrix();
             data.xpos[i] = xpos;
             data.xquat[i] = xquat;
-            data.xmat[i] = *xquat.to_rotation_matrix().matrix();
+            data.xmat[i] = xmat;
+            if body.jnt_num > 0 {
+                let j = last - 1;
+                if self.joints[j].kind == JointType::Hinge {
+                    data.xaxis[j] = xmat * self.joints[j].axis;
+                }
+                self.dof_frames(body.jnt_adr..last, &xmat, data);
+            }
         }
         self.place_geoms_and_sites(data);
-        self.dof_frames(data);
     }
 
     fn place_geoms_and_sites(&self, data: &mut Data) {
         for (g, geom) in self.geoms.iter().enumerate() {
             let (p, r) = (data.xpos[geom.body], data.xmat[geom.body]);
             data.geom_xpos[g] = p + r * geom.pos;
-            data.geom_xmat[g] = r * geom.quat.to_rotation_matrix().matrix();
+            data.geom_xmat[g] = r * self.geom_mat[g];
         }
         for (s, site) in self.sites.iter().enumerate() {
             let (p, r) = (data.xpos[site.body], data.xmat[site.body]);
             data.site_xpos[s] = p + r * site.pos;
-            data.site_xmat[s] = r * site.quat.to_rotation_matrix().matrix();
+            data.site_xmat[s] = r * self.site_mat[s];
         }
     }
 
-    /// World axis and anchor of every dof, as MuJoCo's `cdof`: hinge and slide use the joint
-    /// axis; ball and the free joint's rotation use the columns of the body's `xmat` ("assume
-    /// no subsequent rotations"); the free joint's translation uses the world axes.
-    fn dof_frames(&self, data: &mut Data) {
-        for (j, joint) in self.joints.iter().enumerate() {
-            let d = joint.dof_adr;
-            let (anchor, r) = (data.xanchor[j], data.xmat[joint.body]);
+    /// World axis and anchor of the dofs of `joints` (one body, final orientation `r`), as
+    /// MuJoCo's `cdof`: hinge and slide use the joint axis; ball and the free joint's rotation
+    /// use the columns of the body's `xmat` ("assume no subsequent rotations"); the free
+    /// joint's translation uses the world axes.
+    fn dof_frames(&self, joints: std::ops::Range<usize>, r: &Matrix3<f64>, data: &mut Data) {
+        for j in joints {
+            let joint = &self.joints[j];
+            let (d, anchor) = (joint.dof_adr, data.xanchor[j]);
             match joint.kind {
                 JointType::Hinge | JointType::Slide => {
                     data.dof_axis[d] = data.xaxis[j];

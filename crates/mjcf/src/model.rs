@@ -148,6 +148,11 @@ pub struct Model {
     pub(crate) dof_parent: Vec<Option<usize>>,
     /// Last dof on the path from a body to the world (its own or an ancestor's).
     pub(crate) body_last_dof: Vec<Option<usize>>,
+    /// Per joint: anchor at the body origin (skips the off-centre correction in FK).
+    pub(crate) jnt_pos_zero: Vec<bool>,
+    /// Geom and site orientations as matrices.
+    pub(crate) geom_mat: Vec<nalgebra::Matrix3<f64>>,
+    pub(crate) site_mat: Vec<nalgebra::Matrix3<f64>>,
 }
 
 impl Model {
