@@ -92,12 +92,28 @@ fn mujoco_error(path: &Path, message: impl fmt::Display) -> Error {
 /// Loads `path` with MuJoCo and compares it with `model` (normally `Model::from_file(path)`).
 pub fn check_file(model: &Model, path: &Path, options: CheckOptions) -> Result<Report, Error> {
     let mj = MjModel::from_xml(path).map_err(|e| mujoco_error(path, e))?;
+    Ok(check_loaded(model, &mj, options))
+}
+
+/// Like [`check_file`] for MJCF text without `<include>` (e.g. a model embedded in a binary);
+/// `label` names it in errors.
+pub fn check_xml_str(
+    model: &Model,
+    xml: &str,
+    label: &str,
+    options: CheckOptions,
+) -> Result<Report, Error> {
+    let mj = MjModel::from_xml_string(xml).map_err(|e| mujoco_error(Path::new(label), e))?;
+    Ok(check_loaded(model, &mj, options))
+}
+
+fn check_loaded(model: &Model, mj: &MjModel, options: CheckOptions) -> Report {
     let mut report = Report { configs: options.configs, ..Report::default() };
-    compare_structure(model, &mj, &mut report);
+    compare_structure(model, mj, &mut report);
     if report.mismatches.is_empty() {
-        compare_kinematics(model, &mj, options, &mut report);
+        compare_kinematics(model, mj, options, &mut report);
     }
-    Ok(report)
+    report
 }
 
 fn max_abs(a: &[f64], b: &[f64]) -> f64 {
