@@ -427,3 +427,83 @@ impl<'a> Compiler<'a> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::FRAC_PI_2;
+
+    use crate::{JointType, Model};
+
+    fn model(xml: &str) -> Model {
+        Model::from_xml_str(xml, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn classes_inherit_and_childclass_applies_to_descendants() {
+        let m = model(
+            r#"<mujoco><default><joint axis="1 0 0" range="-10 10"/>
+                 <default class="a"><joint range="-20 20"/><default class="b"><joint axis="0 1 0"/></default></default>
+               </default>
+               <worldbody><body childclass="b"><joint name="j1"/>
+                 <body><joint name="j2" class="a"/><body><joint name="j3" class="main"/></body></body>
+               </body></worldbody></mujoco>"#,
+        );
+        let deg = |d: f64| d.to_radians();
+        let j = |n: &str| &m.joints[m.joint_id(n).unwrap()];
+        assert_eq!((j("j1").axis.y, j("j1").range), (1.0, Some([deg(-20.0), deg(20.0)])));
+        assert_eq!((j("j2").axis.x, j("j2").range), (1.0, Some([deg(-20.0), deg(20.0)])));
+        assert_eq!((j("j3").axis.x, j("j3").range), (1.0, Some([deg(-10.0), deg(10.0)])));
+    }
+
+    #[test]
+    fn frames_compose_into_body_placement() {
+        let m = model(
+            r#"<mujoco><compiler angle="radian"/><worldbody>
+                 <frame pos="1 0 0" euler="0 0 1.5707963267948966"><body name="b" pos="1 0 0"/></frame>
+               </worldbody></mujoco>"#,
+        );
+        let b = &m.bodies[1];
+        assert!((b.pos - nalgebra::Vector3::new(1.0, 1.0, 0.0)).norm() < 1e-15);
+        assert!((b.quat.angle() - FRAC_PI_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn autolimits_and_limited() {
+        let m = model(
+            r#"<mujoco><worldbody><body><joint name="a"/><joint name="b" range="0 1" type="slide"/>
+                 <joint name="c" range="0 1" limited="false"/></body></worldbody></mujoco>"#,
+        );
+        let ranges: Vec<_> = m.joints.iter().map(|j| j.range).collect();
+        assert_eq!(ranges, vec![None, Some([0.0, 1.0]), None]);
+    }
+
+    #[test]
+    fn qpos0_follows_mujoco() {
+        let m = model(
+            r#"<mujoco><worldbody>
+                 <body pos="1 2 3" quat="0 1 0 0"><freejoint/><body><joint type="ball"/>
+                   <body><joint ref="90"/><joint type="slide" ref="0.5"/></body></body></body>
+               </worldbody></mujoco>"#,
+        );
+        let kinds: Vec<_> = m.joints.iter().map(|j| j.kind).collect();
+        assert_eq!(kinds, [JointType::Free, JointType::Ball, JointType::Hinge, JointType::Slide]);
+        assert_eq!((m.nq, m.nv), (13, 11));
+        assert_eq!(&m.qpos0[..11], &[1.0, 2.0, 3.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+        assert!((m.qpos0[11] - FRAC_PI_2).abs() < 1e-15);
+        assert_eq!(m.qpos0[12], 0.5);
+    }
+
+    #[test]
+    fn bodies_are_depth_first_and_joints_by_body() {
+        let m = model(
+            r#"<mujoco><worldbody>
+                 <body name="a"><body name="a1"><joint name="ja1"/></body><joint name="ja"/><body name="a2"/></body>
+                 <body name="b"/>
+               </worldbody></mujoco>"#,
+        );
+        let names: Vec<_> = m.bodies.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["world", "a", "a1", "a2", "b"]);
+        let joints: Vec<_> = m.joints.iter().map(|j| (j.name.as_str(), j.body)).collect();
+        assert_eq!(joints, [("ja", 1), ("ja1", 2)]);
+    }
+}
