@@ -1,21 +1,134 @@
 //! `retarget robots` and `retarget robot …`: the robot models we ship or a user's MJCF.
 
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::process::ExitCode;
 
 use clap::Subcommand;
+use mjcf::{JointType, Model};
+
+use crate::shipped;
 
 #[derive(Subcommand, Debug)]
 pub enum RobotCommand {
     /// Print joints, ranges and bodies of a robot (shipped name or MJCF path).
     Info { robot: String },
+    /// Compare our kinematics with MuJoCo's at random configurations (needs the `mujoco`
+    /// feature): model structure, body poses and body Jacobians.
+    Check {
+        robot: String,
+        /// Number of configurations (the first is qpos0).
+        #[arg(long, default_value_t = 100)]
+        configs: usize,
+        /// Seed of the random configurations.
+        #[arg(long, default_value_t = 20_251_122)]
+        seed: u64,
+        /// Largest deviation that passes.
+        #[arg(long, default_value_t = 1e-9)]
+        tolerance: f64,
+    },
+}
+
+/// Degrees of freedom of the joints other than free joints (the actuated ones of a humanoid).
+fn joint_dofs(model: &Model) -> usize {
+    model.joints.iter().filter(|j| j.kind != JointType::Free).map(|j| j.kind.nv()).sum()
+}
+
+/// Writes `text` to stdout; a closed pipe (`retarget robot info g1 | head`) is not an error.
+fn emit(text: &str) -> anyhow::Result<()> {
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }
 
 pub fn list() -> anyhow::Result<ExitCode> {
-    anyhow::bail!("robots: not implemented yet")
+    let mut out = format!("{:<20} {:>4} {:>4} {:>5} {:>7}\n", "robot", "nq", "nv", "dof", "bodies");
+    for key in shipped::shipped_keys() {
+        let model = shipped::robot_model(key)?;
+        let (nq, nv, dof, nbody) = (model.nq, model.nv, joint_dofs(&model), model.nbody());
+        writeln!(out, "{key:<20} {nq:>4} {nv:>4} {dof:>5} {nbody:>7}")?;
+    }
+    emit(&out)?;
+    Ok(ExitCode::SUCCESS)
 }
 
 pub fn run(cmd: RobotCommand) -> anyhow::Result<ExitCode> {
     match cmd {
-        RobotCommand::Info { robot } => anyhow::bail!("{robot}: robot info is not implemented yet"),
+        RobotCommand::Info { robot } => info(&robot),
+        RobotCommand::Check { robot, configs, seed, tolerance } => {
+            check(&robot, configs, seed, tolerance)
+        }
     }
+}
+
+fn info(robot: &str) -> anyhow::Result<ExitCode> {
+    let model = shipped::robot_model(robot)?;
+    let mut out = String::new();
+    writeln!(out, "robot: {robot}")?;
+    writeln!(
+        out,
+        "nq {}  nv {}  joint dofs {}  bodies {}",
+        model.nq,
+        model.nv,
+        joint_dofs(&model),
+        model.nbody()
+    )?;
+    writeln!(out, "\njoints ({}):", model.joints.len())?;
+    writeln!(out, "  {:>3} {:<32} {:<6} {:>5} {:>5}  range", "id", "name", "type", "qpos", "dof")?;
+    for (i, j) in model.joints.iter().enumerate() {
+        let range = match (j.range, j.kind) {
+            (None, _) => "unlimited".to_owned(),
+            (Some([lo, hi]), JointType::Slide) => format!("[{lo:.4}, {hi:.4}] m"),
+            (Some([lo, hi]), _) => {
+                format!(
+                    "[{lo:.4}, {hi:.4}] rad  ([{:.1}, {:.1}] deg)",
+                    lo.to_degrees(),
+                    hi.to_degrees()
+                )
+            }
+        };
+        let name = if j.name.is_empty() { "(unnamed)" } else { &j.name };
+        writeln!(
+            out,
+            "  {i:>3} {name:<32} {:<6} {:>5} {:>5}  {range}",
+            j.kind.as_str(),
+            j.qpos_adr,
+            j.dof_adr
+        )?;
+    }
+    writeln!(out, "\nbodies ({}):", model.nbody())?;
+    writeln!(out, "  {:>3} {:<32} parent", "id", "name")?;
+    for (i, b) in model.bodies.iter().enumerate() {
+        let parent = if i == 0 { "-" } else { &model.bodies[b.parent].name };
+        writeln!(out, "  {i:>3} {:<32} {parent}", b.name)?;
+    }
+    emit(&out)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(feature = "mujoco")]
+fn check(robot: &str, configs: usize, seed: u64, tolerance: f64) -> anyhow::Result<ExitCode> {
+    use mjcf::mujoco_check::{check_file, check_xml_str, CheckOptions};
+    let model = shipped::robot_model(robot)?;
+    let options = CheckOptions { configs, seed };
+    let report = match shipped::shipped_xml(robot) {
+        Some(xml) => check_xml_str(&model, xml, robot, options)?,
+        None => check_file(&model, std::path::Path::new(robot), options)?,
+    };
+    let verdict = report.passes(tolerance);
+    let mut out = format!("robot: {robot} (ours vs MuJoCo 3.17.0)\n{report}\n");
+    let result = if verdict { "PASS" } else { "FAIL" };
+    writeln!(
+        out,
+        "max deviation {:.3e}: {result} (tolerance {tolerance:e})",
+        report.max_deviation()
+    )?;
+    emit(&out)?;
+    Ok(if verdict { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+#[cfg(not(feature = "mujoco"))]
+fn check(robot: &str, _configs: usize, _seed: u64, _tolerance: f64) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("{robot}: `retarget robot check` needs a build with the `mujoco` feature (cargo build -p cli --features mujoco, after scripts/fetch-mujoco)")
 }

@@ -9,6 +9,7 @@ mod cmd_bvh;
 mod cmd_c3d;
 mod cmd_retarget;
 mod cmd_robot;
+mod shipped;
 
 use std::process::ExitCode;
 

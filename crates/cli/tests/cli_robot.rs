@@ -1,0 +1,140 @@
+//! `retarget robots`, `retarget robot info` and (feature `mujoco`) `retarget robot check`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn retarget(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_retarget")).args(args).output().expect("runs retarget")
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The robots folders with a `<key>/<key>.xml` (what the binary ships).
+fn repo_robot_keys() -> Vec<String> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots");
+    let mut keys: Vec<String> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(Result::ok)
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|k| {
+                    Path::new(env!("CARGO_MANIFEST_DIR"))
+                        .join(format!("../../robots/{k}/{k}.xml"))
+                        .is_file()
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    keys.sort();
+    keys
+}
+
+fn features_xml() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../mjcf/tests/data/features/features.xml")
+}
+
+#[test]
+fn robots_lists_shipped_models_with_sizes() {
+    let out = retarget(&["robots"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    assert!(text.starts_with("robot "), "{text}");
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    let keys: Vec<&str> = rows.iter().filter_map(|r| r.split_whitespace().next()).collect();
+    for key in &keys {
+        assert!(
+            repo_robot_keys().iter().any(|k| k == key),
+            "{key} listed but robots/{key}/{key}.xml missing"
+        );
+    }
+    for row in rows {
+        let cols: Vec<&str> = row.split_whitespace().collect();
+        let model = mjcf::Model::from_file(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("../../robots/{0}/{0}.xml", cols[0])),
+        )
+        .expect("shipped model compiles");
+        assert_eq!(cols[1].parse::<usize>().unwrap(), model.nq, "{row}");
+        assert_eq!(cols[2].parse::<usize>().unwrap(), model.nv, "{row}");
+        assert_eq!(cols[4].parse::<usize>().unwrap(), model.bodies.len(), "{row}");
+    }
+}
+
+#[test]
+fn robot_info_prints_joints_and_bodies() {
+    let path = features_xml();
+    let out = retarget(&["robot", "info", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    let model = mjcf::Model::from_file(&path).unwrap();
+    assert!(text.contains(&format!("nq {}  nv {}", model.nq, model.nv)), "{text}");
+    for joint in &model.joints {
+        let line = text
+            .lines()
+            .find(|l| l.split_whitespace().nth(1) == Some(joint.name.as_str()))
+            .expect("joint line");
+        assert!(line.contains(joint.kind.as_str()), "{line}");
+        assert_eq!(line.contains("unlimited"), joint.range.is_none(), "{line}");
+    }
+    for body in &model.bodies[1..] {
+        let parent = &model.bodies[body.parent].name;
+        assert!(
+            text.lines()
+                .any(|l| l.split_whitespace().skip(1).eq([body.name.as_str(), parent.as_str()])),
+            "{}",
+            body.name
+        );
+    }
+    for key in repo_robot_keys() {
+        let out = retarget(&["robot", "info", &key]);
+        assert!(out.status.success(), "{key}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+}
+
+#[test]
+fn unknown_robot_fails_listing_shipped_keys() {
+    let out = retarget(&["robot", "info", "no_such_robot"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown robot \"no_such_robot\""), "{err}");
+    for key in repo_robot_keys() {
+        assert!(err.contains(&key), "{err}");
+    }
+}
+
+#[test]
+fn bad_mjcf_reports_file_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("cli-robot-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.xml");
+    std::fs::write(&path, "<mujoco>\n<worldbody><body pos=\"1\"/></worldbody></mujoco>").unwrap();
+    let out = retarget(&["robot", "info", path.to_str().unwrap()]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&format!("{}:2:18: attribute pos=\"1\"", path.display())), "{err}");
+}
+
+#[cfg(feature = "mujoco")]
+#[test]
+fn robot_check_agrees_with_mujoco() {
+    let path = features_xml();
+    let mut targets: Vec<String> = repo_robot_keys();
+    targets.push(path.to_str().unwrap().to_owned());
+    for target in targets {
+        let out = retarget(&["robot", "check", &target, "--configs", "20"]);
+        let text = stdout(&out);
+        assert!(out.status.success(), "{target}: {text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("structure: identical") && text.contains("PASS"), "{target}: {text}");
+    }
+}
+
+#[cfg(not(feature = "mujoco"))]
+#[test]
+fn robot_check_needs_the_mujoco_feature() {
+    let out = retarget(&["robot", "check", "unitree_g1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("mujoco"));
+}
