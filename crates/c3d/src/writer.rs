@@ -108,6 +108,7 @@ impl C3d {
         let n = self.analog.channel_count();
         let identity =
             AnalogTransform { offsets: vec![0; n], scales: vec![1.0; n], gen_scale: 1.0 };
+        // Only an integer file's transform maps our values back onto whole numbers.
         if data == DataFormat::Float {
             return identity;
         }
@@ -119,12 +120,13 @@ impl C3d {
             .and_then(|v| v.string_value())
             .is_some_and(|s| s.eq_ignore_ascii_case("UNSIGNED"));
         let mut t = AnalogTransform { offsets: vec![0; n], scales: vec![1.0; n], gen_scale: 1.0 };
-        if !unsigned
+        let reuse = self.format == DataFormat::Integer
+            && !unsigned
             && offsets.len() >= n
             && scales.len() >= n
             && gen_scale.is_finite()
-            && gen_scale != 0.0
-        {
+            && gen_scale != 0.0;
+        if reuse {
             t = AnalogTransform {
                 offsets: offsets[..n].iter().map(|&o| i32::from(o)).collect(),
                 scales: scales[..n].to_vec(),
@@ -133,8 +135,10 @@ impl C3d {
         }
         for c in 0..n {
             let max = self.analog.channel(c).fold(0f32, |m, v| m.max(v.abs()));
-            let fits = self.analog.channel(c).all(|v| quantise_analog(v, c, &t).is_some());
-            if !fits || t.scales[c] == 0.0 {
+            let keep = reuse
+                && t.scales[c] != 0.0
+                && self.analog.channel(c).all(|v| quantise_analog(v, c, &t).is_some());
+            if !keep {
                 t.offsets[c] = 0;
                 t.scales[c] =
                     if max > 0.0 && max.is_finite() { max / INT_RANGE / t.gen_scale } else { 1.0 };
@@ -159,11 +163,25 @@ impl C3d {
         params.set("POINT", "RATE", Value::float(self.point_rate));
         params.set("POINT", "DATA_START", Value::int16(data_block as u16 as i16));
         set_labels(params, "POINT", &self.points.labels);
+        // Parameters every reader expects; a file made from scratch gets defaults.
+        if params.get("POINT", "UNITS").is_none() {
+            params.set("POINT", "UNITS", Value::string("mm"));
+        }
+        if params.get("POINT", "DESCRIPTIONS").is_none() {
+            let blank = vec![String::new(); self.points.point_count()];
+            set_split(params, "POINT", "DESCRIPTIONS", &blank, Value::strings);
+        }
         let channels = self.analog.channel_count();
         if channels > 0 || params.group("ANALOG").is_some() {
             params.set("ANALOG", "USED", Value::int16(channels as u16 as i16));
             params.set("ANALOG", "RATE", Value::float(self.point_rate * spf as f32));
             set_labels(params, "ANALOG", &self.analog.labels);
+            let blank = vec![String::new(); channels];
+            for name in ["UNITS", "DESCRIPTIONS"] {
+                if params.get("ANALOG", name).is_none() {
+                    set_split(params, "ANALOG", name, &blank, Value::strings);
+                }
+            }
             params.remove("ANALOG", "SCALE");
             params.remove("ANALOG", "OFFSET");
             params.remove("ANALOG", "FORMAT");
