@@ -17,7 +17,7 @@ pub enum RobotCommand {
     /// feature): model structure, body poses and body Jacobians.
     Check {
         robot: String,
-        /// Number of configurations (the first is qpos0).
+        /// Number of random configurations (checked in addition to qpos0).
         #[arg(long, default_value_t = 100)]
         configs: usize,
         /// Seed of the random configurations.

@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::{Data, Error, GeomType, JointType, Model};
 
-/// How many random configurations, from which seed.
+/// How many random configurations (checked in addition to `qpos0`), from which seed.
 #[derive(Debug, Clone, Copy)]
 pub struct CheckOptions {
     pub configs: usize,
@@ -76,7 +76,7 @@ impl fmt::Display for Report {
             writeln!(f, "  {m}")?;
         }
         writeln!(f, "max |model data| deviation:  {:.3e}", self.max_static)?;
-        writeln!(f, "over {} random configurations:", self.configs)?;
+        writeln!(f, "over qpos0 and {} random configurations:", self.configs)?;
         writeln!(f, "  max |xpos| deviation:        {:.3e} m", self.max_xpos)?;
         writeln!(f, "  max |xquat| deviation:       {:.3e}", self.max_xquat)?;
         writeln!(f, "  max |jacp| deviation:        {:.3e}", self.max_jacp)?;
@@ -265,7 +265,8 @@ fn compare_kinematics(model: &Model, mj: &MjModel, options: CheckOptions, report
     let n = 3 * model.nv;
     let (mut jacp, mut jacr) = (vec![0.0; n], vec![0.0; n]);
     let mesh: Vec<bool> = model.geoms.iter().map(|g| g.kind == GeomType::Mesh).collect();
-    for c in 0..options.configs {
+    // qpos0 first, then `configs` random configurations.
+    for c in 0..=options.configs {
         let qpos = if c == 0 { model.qpos0.clone() } else { model.random_qpos(&mut rng) };
         model.kinematics(&qpos, &mut data);
         mjd.qpos_mut().copy_from_slice(&qpos);
