@@ -1,0 +1,38 @@
+//! The one error type of this crate.
+
+use thiserror::Error;
+
+/// Everything that can go wrong turning a BVH into a [`crate::HumanMotion`].
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A body name (derived-body source, `require_body`) that the motion does not have.
+    #[error("unknown body `{name}`; available bodies: {}", available.join(", "))]
+    UnknownBody { name: String, available: Vec<String> },
+    /// Two bodies (skeleton joints or derived bodies) with the same name.
+    #[error("duplicate body name `{0}`")]
+    DuplicateBody(String),
+    #[error("the skeleton has no joints")]
+    EmptySkeleton,
+    /// The skeleton is not a tree in parents-first order.
+    #[error("joint `{joint}` (#{index}) has parent #{parent}, which does not come before it")]
+    BadParent { joint: String, index: usize, parent: usize },
+    /// A joint's channels point outside the motion rows.
+    #[error(
+        "joint `{joint}` uses channel columns {first}..{end} but a motion row has {num_channels}"
+    )]
+    ChannelOutOfRange { joint: String, first: usize, end: usize, num_channels: usize },
+    /// The motion matrix does not hold `num_frames × num_channels` values.
+    #[error("motion has {len} values, expected {num_frames} frames × {num_channels} channels")]
+    MotionShape { len: usize, num_frames: usize, num_channels: usize },
+    #[error("frame time must be a positive finite number of seconds, got {0}")]
+    BadFrameTime(f64),
+    /// NaN or infinity in the motion data.
+    #[error("frame {frame}: channel {channel} of joint `{joint}` is {value}")]
+    NonFinite { frame: usize, joint: String, channel: String, value: f64 },
+    #[error("the OFFSET of joint `{0}` is not finite")]
+    NonFiniteOffset(String),
+    /// A scale or height option that is zero, negative or not finite.
+    #[error("invalid option {name} = {value}: must be a positive finite number")]
+    InvalidOption { name: &'static str, value: f64 },
+}

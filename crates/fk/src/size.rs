@@ -1,0 +1,176 @@
+//! How big the subject is: the unit guess (before FK), the subject height and the ground
+//! level (after FK, in metres).
+
+/// Unit candidates, metres per file unit, with the name used in reports.
+const CANDIDATES: [(f64, &str); 5] = [
+    (1.0, "metres"),
+    (0.01, "centimetres"),
+    (0.001, "millimetres"),
+    (0.0254, "inches"),
+    (0.05644, "CMU units (3ds Max-friendly release, mocap.cs.cmu.edu FAQ)"),
+];
+
+/// Stature proxy range (metres) a candidate must land in; see [`choose_units`].
+const PROXY_RANGE: (f64, f64) = (1.0, 2.6);
+/// Typical value of the proxy for an adult (a 1.75 m subject's span or head-to-toe path).
+const PROXY_TYPICAL: f64 = 1.8;
+
+/// The longest path between two joints along the bones (sum of bone lengths, file units):
+/// head-to-toe or fingertip-to-fingertip, which both track stature (arm span ≈ height) in
+/// any rest pose, whichever way its bones point. `lengths[i]` is joint `i`'s bone length to
+/// its parent (0 for roots); parents come before children.
+#[must_use]
+pub(crate) fn tree_diameter(parents: &[Option<usize>], lengths: &[f64]) -> f64 {
+    let n = parents.len();
+    let mut down = vec![0.0_f64; n]; // longest path from a joint down into its subtree
+    let mut best_two = vec![[0.0_f64; 2]; n];
+    for i in (0..n).rev() {
+        down[i] = best_two[i][0];
+        if let Some(parent) = parents[i] {
+            let reach = down[i] + lengths[i];
+            let slot = &mut best_two[parent];
+            if reach > slot[0] {
+                *slot = [reach, slot[0]];
+            } else if reach > slot[1] {
+                slot[1] = reach;
+            }
+        }
+    }
+    best_two.iter().map(|[a, b]| a + b).fold(0.0, f64::max)
+}
+
+/// Pick metres per file unit from the stature proxy `diameter` (file units): the candidate
+/// whose result is closest (in ratio) to a typical adult, among those in a human range. If
+/// none fits, a computed scale making the proxy typical. Returns the scale and the reason.
+#[must_use]
+pub(crate) fn choose_units(diameter: f64) -> (f64, String) {
+    let ratio = |m: f64| ((diameter * m) / PROXY_TYPICAL).ln().abs();
+    let best = CANDIDATES
+        .iter()
+        .filter(|(m, _)| (PROXY_RANGE.0..=PROXY_RANGE.1).contains(&(diameter * m)))
+        .min_by(|a, b| ratio(a.0).total_cmp(&ratio(b.0)));
+    let proxy = format!("longest bone path (head-to-toe / arm span) {diameter:.4} file units");
+    match best {
+        Some(&(m, name)) => {
+            (m, format!("{name}: {proxy} is {:.2} m at {m} m/unit, a human size", diameter * m))
+        }
+        None if diameter.is_finite() && diameter > 0.0 => {
+            let m = PROXY_TYPICAL / diameter;
+            (m, format!("computed: {proxy} fits no known unit; scaled to {PROXY_TYPICAL} m"))
+        }
+        None => (1.0, format!("metres (assumed): {proxy} gives no size to go by")),
+    }
+}
+
+/// Tragion (ear canal, ≈ the skull-base head joint of LAFAN1 and Bandai skeletons) height as
+/// a fraction of stature: ANSUR II gives tragion–top of head ≈ 13 cm for a ≈ 1.75 m adult.
+pub(crate) const HEAD_JOINT_OF_STATURE: f64 = 0.926;
+/// An End Site at least this far (metres) from its head joint marks the top of the head.
+const HEAD_TOP_MIN: f64 = 0.02;
+
+/// Which bodies carry the top of the head and which the soles, by name.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Landmarks {
+    pub(crate) head: Vec<usize>,
+    pub(crate) feet: Vec<usize>,
+    /// The skeleton reaches the top of the head (`*top*` joint or a real head End Site);
+    /// otherwise its highest head point is the head joint and the skull is added.
+    pub(crate) head_top: bool,
+}
+
+impl Landmarks {
+    /// Head: joints named `*head*` and their descendants (End Sites, `HeadTop_End`, eyes);
+    /// feet: `*foot*`, `*toe*`, `*ankle*` and descendants. Missing groups fall back to all
+    /// joints (top = highest point, sole = lowest point).
+    pub(crate) fn find(skeleton: &bvh::Skeleton, metres_per_unit: f64) -> Landmarks {
+        let names: Vec<String> =
+            skeleton.joints.iter().map(|j| j.name.to_ascii_lowercase()).collect();
+        let parents: Vec<Option<usize>> =
+            skeleton.joints.iter().map(|j| j.parent.map(|p| p.0)).collect();
+        let head = subtree_of(&names, &parents, &["head"]);
+        let feet = subtree_of(&names, &parents, &["foot", "toe", "ankle"]);
+        let all: Vec<usize> = (0..names.len()).collect();
+        let head_top = head.is_empty()
+            || head.iter().any(|&i| {
+                let joint = &skeleton.joints[i];
+                let length = nalgebra::Vector3::from(joint.offset).norm() * metres_per_unit;
+                names[i].contains("top")
+                    || (joint.kind == bvh::JointKind::End && length >= HEAD_TOP_MIN)
+            });
+        Landmarks {
+            head: if head.is_empty() { all.clone() } else { head },
+            feet: if feet.is_empty() { all } else { feet },
+            head_top,
+        }
+    }
+}
+
+fn subtree_of(names: &[String], parents: &[Option<usize>], words: &[&str]) -> Vec<usize> {
+    let mut inside = vec![false; names.len()];
+    for i in 0..names.len() {
+        inside[i] =
+            words.iter().any(|w| names[i].contains(w)) || parents[i].is_some_and(|p| inside[p]);
+    }
+    (0..names.len()).filter(|&i| inside[i]).collect()
+}
+
+/// Height and ground of a clip, see [`stature`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Stature {
+    pub(crate) height: f64,
+    pub(crate) source: String,
+    pub(crate) ground: f64,
+}
+
+/// Top of the head minus the lowest foot point (world z, metres), and that foot point.
+fn head_over_sole(positions: &[nalgebra::Vector3<f64>], marks: &Landmarks) -> (f64, f64) {
+    let top = marks.head.iter().map(|&i| positions[i].z).fold(f64::NEG_INFINITY, f64::max);
+    let sole = marks.feet.iter().map(|&i| positions[i].z).fold(f64::INFINITY, f64::min);
+    (top - sole, sole)
+}
+
+/// Fraction of frames allowed above the clip's standing height (tiptoe, glitches).
+const STANDING_QUANTILE: f64 = 0.99;
+/// The rest pose counts as standing if it is at least this tall relative to the clip.
+const REST_UPRIGHT: f64 = 0.9;
+
+/// Subject height: head over sole in the rest pose if the rest pose stands upright (a T- or
+/// A-pose: exact skeleton dimensions, no posture), otherwise in the clip's standing frames
+/// (the 99th percentile of head over sole per frame: the tallest the subject stands, with
+/// tiptoe and glitches excluded; LAFAN1 and Bandai skeletons lie along X in the rest pose).
+/// Skeletons that end at the head joint get the skull added ([`HEAD_JOINT_OF_STATURE`]).
+/// Ground: the lowest foot point over the clip.
+pub(crate) fn stature(
+    frames: impl Iterator<Item = impl AsRef<[nalgebra::Vector3<f64>]>>,
+    rest: &[nalgebra::Vector3<f64>],
+    marks: &Landmarks,
+) -> Stature {
+    let mut heights = Vec::new();
+    let mut ground = f64::INFINITY;
+    for positions in frames {
+        let (h, sole) = head_over_sole(positions.as_ref(), marks);
+        heights.push(h);
+        ground = ground.min(sole);
+    }
+    let (rest_height, rest_sole) = head_over_sole(rest, marks);
+    heights.sort_by(f64::total_cmp);
+    let clip = heights
+        .get(((heights.len().max(1) - 1) as f64 * STANDING_QUANTILE).round() as usize)
+        .copied();
+    let (raw, mut source) = match clip {
+        Some(h) if rest_height < REST_UPRIGHT * h => (
+            h,
+            format!("99th percentile over {} frames of head over lowest foot point", heights.len()),
+        ),
+        _ => (rest_height, "rest pose, head over lowest foot point".to_owned()),
+    };
+    let height = if marks.head_top {
+        raw
+    } else {
+        source.push_str(&format!(
+            " ({raw:.3} m to the head joint; skull added: head joint at {HEAD_JOINT_OF_STATURE} of stature)"
+        ));
+        raw / HEAD_JOINT_OF_STATURE
+    };
+    Stature { height, source, ground: if ground.is_finite() { ground } else { rest_sole } }
+}
