@@ -1,6 +1,15 @@
 //! Retargeting: GMR-schema IK configs, per-frame targets, the damped-least-squares solver,
 //! the resulting robot motion, its writers and quality metrics.
 
+pub mod config;
+pub mod lie;
 pub mod motion;
+pub mod pipeline;
+pub mod qp;
+pub mod solver;
+pub mod targets;
 
+pub use config::{IkConfig, MatchEntry};
 pub use motion::{RobotMotion, TrackedTargets};
+pub use pipeline::{retarget_bvh, retarget_motion, ClipDiagnostics, Error, RetargetOptions};
+pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};
