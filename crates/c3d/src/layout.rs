@@ -120,6 +120,10 @@ impl Layout {
             data_start,
         };
         let frame_size = layout.frame_size() as u64;
+        if frame_size == 0 && announced > 0 {
+            warnings.push(format!("{announced} frames announced, but a frame holds no data"));
+            layout.frame_count = 0;
+        }
         if let Some(available) = file_len.saturating_sub(data_start).checked_div(frame_size) {
             let available = usize::try_from(available).unwrap_or(usize::MAX);
             if announced > available {

@@ -352,7 +352,9 @@ enum Next {
 
 fn parse_item(buf: &[u8], pos: usize, p: Processor) -> Result<(Item, Next), String> {
     let take = |at: usize, n: usize| {
-        buf.get(at..at + n).ok_or_else(|| "it runs past the end of the section".to_string())
+        at.checked_add(n)
+            .and_then(|end| buf.get(at..end))
+            .ok_or_else(|| "it runs past the end of the section".to_string())
     };
     let name_len = buf[pos] as i8;
     let id = buf[pos + 1] as i8;
@@ -378,15 +380,17 @@ fn parse_item(buf: &[u8], pos: usize, p: Processor) -> Result<(Item, Next), Stri
     at += 2;
     let dims: Vec<usize> = take(at, ndims)?.iter().map(|&d| usize::from(d)).collect();
     at += ndims;
-    let count: usize = dims.iter().product();
+    let too_big = || format!("parameter {name} has dimensions {dims:?} larger than the section");
+    let count = dims.iter().try_fold(1usize, |n, &d| n.checked_mul(d)).ok_or_else(too_big)?;
     let size = match type_byte {
         -1 | 1 => 1,
         2 => 2,
         4 => 4,
         other => return Err(format!("parameter {name} has unknown type {other}")),
     };
-    let raw = take(at, count * size)?;
-    at += count * size;
+    let bytes = count.checked_mul(size).ok_or_else(too_big)?;
+    let raw = take(at, bytes)?;
+    at += bytes;
     let data = match type_byte {
         -1 => Data::Char(raw.to_vec()),
         1 => Data::Byte(raw.to_vec()),
