@@ -70,12 +70,14 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
     let head = r - w;
     let tail = (r - head) - w;
     let (s, c) = (kernel_sin(head, tail), kernel_cos(head, tail));
-    match (n as i64) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    // Quadrant q: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s). Branch-free: the quadrant
+    // of a joint angle is data, and a mispredicted branch costs as much as the polynomials.
+    let q = n as i64 as u64;
+    let swap = 0u64.wrapping_sub(q & 1);
+    let (s, c) = (s.to_bits(), c.to_bits());
+    let sin = (s & !swap) | (c & swap);
+    let cos = (c & !swap) | (s & swap);
+    (f64::from_bits(sin ^ ((q & 2) << 62)), f64::from_bits(cos ^ (((q + 1) & 2) << 62)))
 }
 
 #[cfg(test)]
