@@ -6,8 +6,10 @@ pub mod lie;
 pub mod motion;
 pub mod pipeline;
 pub mod qp;
+pub mod report;
 pub mod solver;
 pub mod targets;
+pub mod writers;
 
 pub use config::{IkConfig, MatchEntry};
 pub use motion::{RobotMotion, TrackedTargets};

@@ -1,0 +1,40 @@
+//! Unitree's LAFAN1-retargeting CSV (the layout of `unitreerobotics/LAFAN1_Retargeting_Dataset`):
+//! no header, one frame per line, comma-separated: root `x, y, z` (m), root quaternion
+//! `qx, qy, qz, qw`, then every other `qpos` entry in MJCF order. Numbers are the shortest
+//! strings that parse back to the same `f64` (ryu).
+
+use std::io::Write;
+
+use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, BodyPoses};
+use crate::motion::RobotMotion;
+
+pub(crate) fn write_csv<W: Write>(
+    out: &mut W,
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+) -> std::io::Result<()> {
+    let skip = root_nq(model);
+    // The root comes from qpos for a free-floating model; FK is needed only without one.
+    let poses = if skip == 7 {
+        BodyPoses { bodies: 0, pos: Vec::new(), quat: Vec::new() }
+    } else {
+        body_poses(motion, model)
+    };
+    let mut buf = ryu::Buffer::new();
+    let mut line = String::new();
+    for t in 0..motion.num_frames() {
+        line.clear();
+        let (pos, wxyz) = root_pose(motion, model, &poses, t);
+        let xyzw = xyzw_from_wxyz(wxyz);
+        let values = pos.iter().chain(&xyzw).chain(&motion.frame(t)[skip..]);
+        for (i, v) in values.enumerate() {
+            if i > 0 {
+                line.push(',');
+            }
+            line.push_str(buf.format(*v));
+        }
+        line.push('\n');
+        out.write_all(line.as_bytes())?;
+    }
+    Ok(())
+}

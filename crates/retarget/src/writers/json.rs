@@ -1,0 +1,87 @@
+//! `.json`: the whole motion, human-readable, one frame per line.
+//!
+//! ```text
+//! {
+//!   "format": "retarget-motion", "version": 1,
+//!   "robot": "unitree_g1",            // MJCF model name ("" when the file has none)
+//!   "conventions": {...},              // frame, units, quaternion order
+//!   "fps": 30.0, "nq": 36, "num_frames": T,
+//!   "joint_names": [...], "body_names": [...],
+//!   "qpos": [[x, y, z, qw, qx, qy, qz, joints...], ...],
+//!   "targets": null | {"body_names": [...], "pos": [[[x, y, z], ...], ...],
+//!                      "quat": [[[w, x, y, z], ...], ...]}
+//! }
+//! ```
+
+use std::io::Write;
+
+use serde_json::json;
+
+use crate::motion::RobotMotion;
+
+pub(crate) fn write_json<W: Write>(
+    out: &mut W,
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+) -> std::io::Result<()> {
+    let head = json!({
+        "format": "retarget-motion",
+        "version": 1,
+        "robot": model.name,
+        "conventions": {
+            "up": "z",
+            "length": "m",
+            "angle": "rad",
+            "quaternion": "w x y z",
+            "qpos": "MuJoCo layout: free root x y z qw qx qy qz, then joints in MJCF order",
+        },
+        "fps": motion.fps,
+        "nq": motion.nq,
+        "num_frames": motion.num_frames(),
+        "joint_names": motion.joint_names,
+        "body_names": motion.body_names,
+    });
+    let head = serde_json::to_string_pretty(&head)?;
+    // Everything but the closing brace, then the per-frame arrays one row per line.
+    let head = head.trim_end().strip_suffix('}').unwrap_or(&head).trim_end();
+    writeln!(out, "{head},")?;
+    let frames = motion.num_frames();
+    write_rows(out, "qpos", (0..frames).map(|t| serde_json::to_string(motion.frame(t))))?;
+    match &motion.targets {
+        None => writeln!(out, ",\n  \"targets\": null")?,
+        Some(targets) => {
+            let k = targets.body_names.len();
+            writeln!(out, ",\n  \"targets\": {{")?;
+            writeln!(out, "  \"body_names\": {},", serde_json::to_string(&targets.body_names)?)?;
+            let pos_rows = (0..frames).map(|t| {
+                let row = &targets.pos[t * k..(t + 1) * k];
+                serde_json::to_string(&row.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>())
+            });
+            write_rows(out, "pos", pos_rows)?;
+            writeln!(out, ",")?;
+            let quat_rows = (0..frames).map(|t| {
+                let row = &targets.quat[t * k..(t + 1) * k];
+                serde_json::to_string(&row.iter().map(|q| [q.w, q.i, q.j, q.k]).collect::<Vec<_>>())
+            });
+            write_rows(out, "quat", quat_rows)?;
+            writeln!(out, "\n  }}")?;
+        }
+    }
+    writeln!(out, "}}")?;
+    Ok(())
+}
+
+/// `  "key": [\n    row,\n    row\n  ]` (no trailing newline).
+fn write_rows<W: Write>(
+    out: &mut W,
+    key: &str,
+    rows: impl Iterator<Item = serde_json::Result<String>>,
+) -> std::io::Result<()> {
+    write!(out, "  \"{key}\": [")?;
+    for (i, row) in rows.enumerate() {
+        let sep = if i == 0 { "" } else { "," };
+        write!(out, "{sep}\n    {}", row?)?;
+    }
+    write!(out, "\n  ]")?;
+    Ok(())
+}

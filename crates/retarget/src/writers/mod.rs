@@ -1,0 +1,262 @@
+//! Output writers: a [`RobotMotion`] to `.npz` (numpy, the default), Unitree's `.csv`, GMR's
+//! `.pkl` and a human-readable `.json`, and back from our `.npz`.
+//!
+//! Every file is in the world frame of the pipeline: Z up, metres, radians. Quaternions are
+//! w-first in our own files (`.npz`, `.json`); the two formats that define x y z w (the
+//! Unitree CSV root and GMR's `root_rot`) are converted by [`xyzw_from_wxyz`] and nowhere else.
+//!
+//! Files are written atomically: into a temporary file next to the target, flushed to disk,
+//! then renamed over it. On error the temporary file is removed, so an interrupted or failed
+//! run never leaves a half-written file under the final name.
+
+mod csv;
+mod derived;
+mod json;
+pub mod npy;
+mod npz;
+mod pickle;
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use crate::motion::RobotMotion;
+
+pub(crate) use derived::{angular_velocity, body_poses, gradient_rows, BodyPoses};
+pub use npz::{read_motion_npz, read_npz_robot};
+
+/// Output formats, chosen by file extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// numpy `.npz`: `qpos`, names and BeyondMimic's keys (see [`write_motion`]).
+    Npz,
+    /// Unitree's LAFAN1-retargeting CSV: `x y z qx qy qz qw joints…` per line, no header.
+    Csv,
+    /// GMR's pickle: `fps`, `root_pos`, `root_rot` (x y z w), `dof_pos`, `local_body_pos`,
+    /// `link_body_list`.
+    Pkl,
+    /// Everything, human-readable.
+    Json,
+}
+
+impl Format {
+    /// The format of a path by its extension (case-insensitive): `npz`, `csv`, `pkl`
+    /// (or `pickle`), `json`.
+    #[must_use]
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "npz" => Some(Format::Npz),
+            "csv" => Some(Format::Csv),
+            "pkl" | "pickle" => Some(Format::Pkl),
+            "json" => Some(Format::Json),
+            _ => None,
+        }
+    }
+
+    /// The usual extension, without the dot.
+    #[must_use]
+    pub const fn extension(self) -> &'static str {
+        match self {
+            Format::Npz => "npz",
+            Format::Csv => "csv",
+            Format::Pkl => "pkl",
+            Format::Json => "json",
+        }
+    }
+}
+
+/// Errors of the writers, the `.npz` reader and the quality report.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: unknown output format (expected .npz, .csv, .pkl or .json)", path.display())]
+    UnknownFormat { path: PathBuf },
+    #[error("motion does not fit the robot model: {0}")]
+    Mismatch(String),
+    #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
+    NonFinite { frame: usize, index: usize, value: f64 },
+    #[error("{}: {message}", path.display())]
+    Read { path: PathBuf, message: String },
+    #[error("{0}")]
+    Options(String),
+}
+
+/// Writes `motion` to `path` in `format` (by default the one of the extension), atomically.
+///
+/// `model` is the robot the motion was solved for: it gives the body poses (forward
+/// kinematics) that `.npz` and `.pkl` carry, and must match the motion (`nq`, body names).
+///
+/// `.npz` keys (float64 little-endian, names as numpy unicode arrays, T frames, B bodies
+/// without the world, K target bodies; loads with `numpy.load(path, allow_pickle=False)`):
+/// - `fps` (shape `(1,)`, as BeyondMimic writes it), `qpos` (T×nq), `joint_names`,
+///   `body_names`, `robot` (0-d string: the MJCF `model` attribute, when the model has one);
+/// - BeyondMimic's: `joint_pos` (T×(nq−7): `qpos` after the free root), `joint_vel` (same
+///   shape), `body_pos_w` (T×B×3), `body_quat_w` (T×B×4, w x y z), `body_lin_vel_w` and
+///   `body_ang_vel_w` (T×B×3, world frame);
+/// - when the motion has targets: `target_body_names`, `target_pos` (T×K×3), `target_quat`
+///   (T×K×4, w x y z).
+///
+/// Velocities are finite differences with numpy's `gradient` scheme: central differences
+/// `(x[t+1] − x[t−1]) / 2Δt` inside, one-sided `(x[1] − x[0]) / Δt` and
+/// `(x[T−1] − x[T−2]) / Δt` at the ends, zero for a single frame. Angular velocity is the
+/// same scheme on rotations: `log(q[b] q[a]⁻¹) / ((b − a) Δt)`, the world-frame rotation
+/// vector between the two frames (shortest way).
+pub fn write_motion(
+    path: &Path,
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    format: Option<Format>,
+) -> Result<(), Error> {
+    let format = match format.or_else(|| Format::from_path(path)) {
+        Some(f) => f,
+        None => return Err(Error::UnknownFormat { path: path.to_path_buf() }),
+    };
+    check_motion(motion, model)?;
+    match format {
+        Format::Npz => {
+            let arrays = npz::motion_arrays(motion, model);
+            write_atomically(path, |w| npz::write_npz(w, &arrays))
+        }
+        Format::Csv => write_atomically(path, |w| csv::write_csv(w, motion, model)),
+        Format::Pkl => {
+            let bytes = pickle::motion_pickle(motion, model)?;
+            write_atomically(path, |w| w.write_all(&bytes))
+        }
+        Format::Json => write_atomically(path, |w| json::write_json(w, motion, model)),
+    }
+}
+
+/// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
+/// `root_rot` use it. The only place where our files change quaternion order.
+#[must_use]
+pub const fn xyzw_from_wxyz(wxyz: [f64; 4]) -> [f64; 4] {
+    [wxyz[1], wxyz[2], wxyz[3], wxyz[0]]
+}
+
+/// Checks that `motion` is one of `model`'s and holds only finite numbers.
+pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<(), Error> {
+    if motion.nq != model.nq {
+        return Err(Error::Mismatch(format!("motion nq {} but model nq {}", motion.nq, model.nq)));
+    }
+    if motion.qpos.len().checked_rem(motion.nq) != Some(0) {
+        return Err(Error::Mismatch(format!(
+            "qpos length {} is not a multiple of nq {}",
+            motion.qpos.len(),
+            motion.nq
+        )));
+    }
+    let model_bodies = model.bodies.iter().skip(1).map(|b| b.name.as_str());
+    if !motion.body_names.iter().map(String::as_str).eq(model_bodies) {
+        return Err(Error::Mismatch("body names differ from the model's".to_owned()));
+    }
+    if !(motion.fps.is_finite() && motion.fps > 0.0) {
+        return Err(Error::Mismatch(format!("fps {} is not positive", motion.fps)));
+    }
+    if let Some(i) = motion.qpos.iter().position(|v| !v.is_finite()) {
+        let (frame, index) = (i / motion.nq, i % motion.nq);
+        return Err(Error::NonFinite { frame, index, value: motion.qpos[i] });
+    }
+    if let Some(t) = &motion.targets {
+        let expected = motion.num_frames() * t.body_names.len();
+        if t.pos.len() != expected || t.quat.len() != expected {
+            return Err(Error::Mismatch(format!(
+                "targets hold {} positions and {} orientations, expected {expected}",
+                t.pos.len(),
+                t.quat.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Number of `qpos` entries of the free root (7), or 0 when the first joint is not a free
+/// joint at `qpos[0]`.
+pub(crate) fn root_nq(model: &mjcf::Model) -> usize {
+    match model.joints.first() {
+        Some(j) if j.kind == mjcf::JointType::Free && j.qpos_adr == 0 => 7,
+        _ => 0,
+    }
+}
+
+/// Root position and w-first orientation of one frame: the free joint's `qpos`, or the world
+/// pose of the first body for a fixed-base model.
+pub(crate) fn root_pose(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    poses: &BodyPoses,
+    frame: usize,
+) -> ([f64; 3], [f64; 4]) {
+    if root_nq(model) == 7 {
+        let q = motion.frame(frame);
+        ([q[0], q[1], q[2]], [q[3], q[4], q[5], q[6]])
+    } else {
+        let p = poses.pos(frame, 0);
+        let q = poses.quat(frame, 0);
+        ([p.x, p.y, p.z], [q.w, q.i, q.j, q.k])
+    }
+}
+
+static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// Writes through `fill` into `.<name>.tmp-<pid>-<n>` next to `path`, syncs, renames it to
+/// `path`; removes the temporary file on any error.
+fn write_atomically<F>(path: &Path, fill: F) -> Result<(), Error>
+where
+    F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+{
+    let io_error = |source| Error::Io { path: path.to_path_buf(), source };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()));
+    let file = File::create(&tmp).map_err(io_error)?;
+    let mut writer = BufWriter::new(file);
+    let result = fill(&mut writer)
+        .and_then(|()| writer.into_inner().map_err(std::io::IntoInnerError::into_error))
+        .and_then(|file| file.sync_all())
+        .and_then(|()| std::fs::rename(&tmp, path));
+    if let Err(source) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io_error(source));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_by_extension() {
+        assert_eq!(Format::from_path(Path::new("a/b.NPZ")), Some(Format::Npz));
+        assert_eq!(Format::from_path(Path::new("b.csv")), Some(Format::Csv));
+        assert_eq!(Format::from_path(Path::new("b.pkl")), Some(Format::Pkl));
+        assert_eq!(Format::from_path(Path::new("b.json")), Some(Format::Json));
+        assert_eq!(Format::from_path(Path::new("b.bvh")), None);
+        assert_eq!(Format::from_path(Path::new("npz")), None);
+    }
+
+    #[test]
+    fn xyzw_moves_w_last() {
+        assert_eq!(xyzw_from_wxyz([1.0, 2.0, 3.0, 4.0]), [2.0, 3.0, 4.0, 1.0]);
+    }
+
+    #[test]
+    fn failed_writes_leave_nothing_behind() {
+        let dir = std::env::temp_dir().join(format!("retarget-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.csv");
+        let result = write_atomically(&path, |w| {
+            w.write_all(b"partial")?;
+            Err(std::io::Error::other("interrupted"))
+        });
+        assert!(result.is_err());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+        write_atomically(&path, |w| w.write_all(b"whole")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"whole");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

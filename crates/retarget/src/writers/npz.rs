@@ -1,0 +1,203 @@
+//! `.npz`: numpy's zip archive of `<key>.npy` members (as `numpy.savez_compressed` writes it:
+//! deflate), and the reader for our own files.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{Read, Seek, Write};
+use std::path::Path;
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+use super::npy::{self, Array, ArrayData};
+use super::{angular_velocity, body_poses, gradient_rows, root_nq, Error};
+use crate::motion::{RobotMotion, TrackedTargets};
+
+/// The arrays of a motion's `.npz`, in file order (see [`super::write_motion`]).
+pub(crate) fn motion_arrays(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+) -> Vec<(&'static str, Array)> {
+    let frames = motion.num_frames();
+    let dt = 1.0 / motion.fps;
+    let mut arrays = vec![
+        ("fps", Array::f64(vec![1], vec![motion.fps])),
+        ("qpos", Array::f64(vec![frames, motion.nq], motion.qpos.clone())),
+        ("joint_names", Array::strings(&motion.joint_names)),
+        ("body_names", Array::strings(&motion.body_names)),
+    ];
+    if !model.name.is_empty() {
+        arrays.push(("robot", Array::scalar_string(&model.name)));
+    }
+    let skip = root_nq(model);
+    let cols = motion.nq - skip;
+    let joint_pos: Vec<f64> = (0..frames).flat_map(|t| motion.frame(t)[skip..].to_vec()).collect();
+    let joint_vel = gradient_rows(&joint_pos, cols, dt);
+    arrays.push(("joint_pos", Array::f64(vec![frames, cols], joint_pos)));
+    arrays.push(("joint_vel", Array::f64(vec![frames, cols], joint_vel)));
+
+    let poses = body_poses(motion, model);
+    let b = poses.bodies;
+    let flat_pos: Vec<f64> = poses.pos.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    let lin_vel = gradient_rows(&flat_pos, b * 3, dt);
+    let ang_vel: Vec<f64> =
+        angular_velocity(&poses.quat, b, dt).iter().flat_map(|w| [w.x, w.y, w.z]).collect();
+    arrays.push(("body_pos_w", Array::f64(vec![frames, b, 3], flat_pos)));
+    arrays.push(("body_quat_w", Array::f64(vec![frames, b, 4], wxyz_flat(&poses.quat))));
+    arrays.push(("body_lin_vel_w", Array::f64(vec![frames, b, 3], lin_vel)));
+    arrays.push(("body_ang_vel_w", Array::f64(vec![frames, b, 3], ang_vel)));
+
+    if let Some(targets) = &motion.targets {
+        let k = targets.body_names.len();
+        let pos = targets.pos.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+        arrays.push(("target_body_names", Array::strings(&targets.body_names)));
+        arrays.push(("target_pos", Array::f64(vec![frames, k, 3], pos)));
+        arrays.push(("target_quat", Array::f64(vec![frames, k, 4], wxyz_flat(&targets.quat))));
+    }
+    arrays
+}
+
+fn wxyz_flat(quats: &[UnitQuaternion<f64>]) -> Vec<f64> {
+    quats.iter().flat_map(|q| [q.w, q.i, q.j, q.k]).collect()
+}
+
+/// Writes `arrays` as an `.npz` (deflate-compressed members `<key>.npy`).
+pub(crate) fn write_npz<W: Write + Seek>(out: W, arrays: &[(&str, Array)]) -> std::io::Result<()> {
+    let mut zip = zip::ZipWriter::new(out);
+    for (key, array) in arrays {
+        let bytes = npy::encode(array);
+        let options = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .large_file(bytes.len() as u64 >= u64::from(u32::MAX));
+        zip.start_file(format!("{key}.npy"), options).map_err(std::io::Error::other)?;
+        zip.write_all(&bytes)?;
+    }
+    zip.finish().map_err(std::io::Error::other)?;
+    Ok(())
+}
+
+/// Every `<key>.npy` of an `.npz`, by key.
+fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
+    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
+    let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut zip =
+        zip::ZipArchive::new(file).map_err(|e| read_error(format!("not an .npz: {e}")))?;
+    let mut arrays = BTreeMap::new();
+    for i in 0..zip.len() {
+        let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
+        let Some(key) = member.name().strip_suffix(".npy").map(str::to_owned) else { continue };
+        let mut bytes = Vec::with_capacity(usize::try_from(member.size()).unwrap_or(0));
+        member.read_to_end(&mut bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
+        let array = npy::decode(&bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
+        arrays.insert(key, array);
+    }
+    Ok(arrays)
+}
+
+/// Reads a motion back from an `.npz` written by [`super::write_motion`] (or any `.npz` with
+/// `fps` (one number), `qpos` (T×nq), `joint_names`, `body_names` and optionally
+/// `target_body_names`, `target_pos` (T×K×3), `target_quat` (T×K×4, w first)).
+pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
+    let arrays = read_npz(path)?;
+    let err = |message: String| Error::Read { path: path.to_path_buf(), message };
+    let get = |key: &str| arrays.get(key).ok_or_else(|| err(format!("no `{key}` array")));
+    let fps = match floats(get("fps")?) {
+        Some([fps]) => *fps,
+        _ => return Err(err("`fps` is not a single number".to_owned())),
+    };
+    let qpos = get("qpos")?;
+    let (Some(values), [frames, nq]) = (floats(qpos), qpos.shape.as_slice()) else {
+        return Err(err("`qpos` is not a 2-D float array".to_owned()));
+    };
+    let joint_names =
+        strings(get("joint_names")?).ok_or_else(|| err("bad `joint_names`".into()))?;
+    let body_names = strings(get("body_names")?).ok_or_else(|| err("bad `body_names`".into()))?;
+    let targets = match arrays.get("target_body_names") {
+        None => None,
+        Some(names) => Some(
+            read_targets(names, get("target_pos")?, get("target_quat")?, *frames).map_err(err)?,
+        ),
+    };
+    Ok(RobotMotion {
+        fps,
+        nq: *nq,
+        qpos: values.to_vec(),
+        joint_names: joint_names.to_vec(),
+        body_names: body_names.to_vec(),
+        targets,
+    })
+}
+
+/// The `robot` name stored in an `.npz` by [`super::write_motion`], if any.
+pub fn read_npz_robot(path: &Path) -> Result<Option<String>, Error> {
+    let arrays = read_npz(path)?;
+    Ok(arrays.get("robot").and_then(strings).and_then(|s| s.first().cloned()))
+}
+
+fn read_targets(
+    names: &Array,
+    pos: &Array,
+    quat: &Array,
+    frames: usize,
+) -> Result<TrackedTargets, String> {
+    let names = strings(names).ok_or("bad `target_body_names`")?;
+    let k = names.len();
+    let (Some(p), Some(q)) = (floats(pos), floats(quat)) else {
+        return Err("`target_pos` and `target_quat` must be float arrays".to_owned());
+    };
+    if pos.shape != [frames, k, 3] || quat.shape != [frames, k, 4] {
+        return Err(format!(
+            "target arrays have shapes {:?} and {:?}, expected ({frames}, {k}, 3) and ({frames}, {k}, 4)",
+            pos.shape, quat.shape
+        ));
+    }
+    let pos = p.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
+    let quat = q
+        .chunks_exact(4)
+        .map(|c| {
+            let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+            match q.norm() {
+                n if (n - 1.0).abs() < 1e-9 => Ok(UnitQuaternion::new_unchecked(q)),
+                n if n > 1e-9 && n.is_finite() => Ok(UnitQuaternion::new_normalize(q)),
+                _ => Err("a target quaternion is zero or not finite".to_owned()),
+            }
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(TrackedTargets { body_names: names.to_vec(), pos, quat })
+}
+
+fn floats(a: &Array) -> Option<&[f64]> {
+    match &a.data {
+        ArrayData::F64(v) => Some(v),
+        ArrayData::Str(_) => None,
+    }
+}
+
+fn strings(a: &Array) -> Option<&[String]> {
+    match &a.data {
+        ArrayData::Str(v) => Some(v),
+        ArrayData::F64(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npz_members_round_trip() {
+        let arrays = [
+            ("fps", Array::f64(vec![1], vec![30.0])),
+            ("names", Array::strings(&["a".to_owned(), "bc".to_owned()])),
+        ];
+        let mut buf = std::io::Cursor::new(Vec::new());
+        write_npz(&mut buf, &arrays).unwrap();
+        let dir = std::env::temp_dir().join(format!("retarget-npz-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.npz");
+        std::fs::write(&path, buf.into_inner()).unwrap();
+        let back = read_npz(&path).unwrap();
+        assert_eq!(back["fps"], arrays[0].1);
+        assert_eq!(back["names"], arrays[1].1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
