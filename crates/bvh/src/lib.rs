@@ -3,7 +3,41 @@
 //! The data model is the file as written: a flat skeleton in file order (parents before
 //! children) and a dense `frames × channels` matrix of `f64`. Nothing here knows about
 //! units, axes or robots; `fk` gives the numbers meaning.
+//!
+//! ```
+//! let text = "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n\
+//!             End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.5\n1 2 3\n";
+//! let bvh = bvh::from_str(text)?;
+//! assert_eq!(bvh.skeleton.joints[1].name, "Hips_End");
+//! let mut out = Vec::new();
+//! bvh::write(&bvh, &mut out)?;
+//! assert_eq!(bvh::parse(&out)?, bvh);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
+mod error;
+mod float;
+mod parse;
 mod skeleton;
+mod summary;
+mod write;
 
+use std::path::Path;
+
+pub use error::{Error, Pos};
+pub use parse::parse;
 pub use skeleton::{Axis, Bvh, Channel, Joint, JointId, JointKind, Motion, Skeleton};
+pub use summary::{Summary, SummaryJoint, Units};
+pub use write::{write, write_json};
+
+/// Parse BVH text held in a string (see [`parse`]).
+#[allow(clippy::should_implement_trait)] // a free function, like `serde_json::from_str`
+pub fn from_str(text: &str) -> Result<Bvh, Error> {
+    parse(text.as_bytes())
+}
+
+/// Read and parse a BVH file; errors name the file (`path:line:column: message`).
+pub fn from_path(path: &Path) -> Result<Bvh, Error> {
+    let bytes = std::fs::read(path).map_err(|err| Error::Io { path: path.to_path_buf(), err })?;
+    parse(&bytes).map_err(|e| e.in_file(path))
+}
