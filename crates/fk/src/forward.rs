@@ -68,17 +68,21 @@ impl Plan {
         self.joints.iter().map(|j| j.offset)
     }
 
-    /// Global poses (file axes and units) of one frame's channel `row` into `q`, `p`.
+    /// Global poses (file axes and units) of one frame into `q`, `p`: `row` is the frame's
+    /// channel values, `sin`/`cos` those of the half angles of every column.
     #[inline]
-    pub(crate) fn global(&self, row: &[f64], q: &mut [Quat], p: &mut [[f64; 3]]) {
+    pub(crate) fn global(&self, row: &Row, q: &mut [Quat], p: &mut [[f64; 3]]) {
         for (i, joint) in self.joints.iter().enumerate() {
             let mut local_p = joint.offset;
             for (c, column) in joint.position_columns.iter().enumerate() {
                 if let Some(column) = column {
-                    local_p[c] = row[*column];
+                    local_p[c] = row.values[*column];
                 }
             }
-            let local_q = math::euler_quat(joint.rotations.iter().map(|&(a, col)| (a, row[col])));
+            // q(a₁) ⊗ (q(a₂) ⊗ q(a₃)): fold from the right (`math::euler_quat`).
+            let local_q = joint.rotations.iter().rev().fold(math::IDENTITY, |q, &(axis, col)| {
+                math::axis_mul(axis, row.cos[col], row.sin[col], &q)
+            });
             match joint.parent {
                 None => {
                     q[i] = local_q;
@@ -107,7 +111,7 @@ impl Plan {
                 })
                 .collect(),
         };
-        rest.global(&[], q, p);
+        rest.global(&Row::default(), q, p);
     }
 }
 
@@ -156,6 +160,24 @@ pub(crate) fn axis_index(axis: Axis) -> usize {
         Axis::X => 0,
         Axis::Y => 1,
         Axis::Z => 2,
+    }
+}
+
+/// One frame's channel values and the sine and cosine of their half angles (degrees).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Row {
+    values: Vec<f64>,
+    sin: Vec<f64>,
+    cos: Vec<f64>,
+}
+
+impl Row {
+    fn load(&mut self, values: &[f64]) {
+        self.values.clear();
+        self.values.extend_from_slice(values);
+        self.sin.resize(values.len(), 0.0);
+        self.cos.resize(values.len(), 0.0);
+        crate::trig::half_angles_sin_cos(values, &mut self.sin, &mut self.cos);
     }
 }
 
@@ -224,8 +246,10 @@ pub(crate) fn run(
     let mut orientations: Vec<UnitQuaternion<f64>> = Vec::with_capacity(total);
     let mut q = vec![math::IDENTITY; n];
     let mut p = vec![[0.0; 3]; n];
+    let mut row = Row::default();
     for frame in 0..bvh.motion.num_frames {
-        plan.global(bvh.motion.frame(frame), &mut q, &mut p);
+        row.load(bvh.motion.frame(frame));
+        plan.global(&row, &mut q, &mut p);
         let base = frame * stride;
         for i in 0..n {
             let mut wq = world.orientation(&q[i]);

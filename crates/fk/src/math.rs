@@ -73,11 +73,12 @@ pub(crate) fn axis_mul(axis: Axis, c: f64, s: f64, y: &Quat) -> Quat {
 }
 
 /// `(sin, cos)` of half the angle `degrees`, converted as numpy's `radians` does.
-#[inline]
+#[cfg(test)]
 fn half_sin_cos(degrees: f64) -> (f64, f64) {
     crate::trig::sin_cos(degrees.to_radians() / 2.0)
 }
 
+#[cfg(test)]
 /// `q(a₁) ⊗ (q(a₂) ⊗ q(a₃))` for rotation channels listed as `a₁ a₂ a₃` (intrinsic, in file
 /// order: R = R₁·R₂·R₃). Folding from the right reproduces `euler_to_quat`'s association.
 #[must_use]

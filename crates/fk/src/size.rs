@@ -153,10 +153,9 @@ pub(crate) fn stature(
         ground = ground.min(sole);
     }
     let (rest_height, rest_sole) = head_over_sole(rest, marks);
-    heights.sort_by(f64::total_cmp);
-    let clip = heights
-        .get(((heights.len().max(1) - 1) as f64 * STANDING_QUANTILE).round() as usize)
-        .copied();
+    let rank = ((heights.len().max(1) - 1) as f64 * STANDING_QUANTILE).round() as usize;
+    let clip =
+        (rank < heights.len()).then(|| *heights.select_nth_unstable_by(rank, f64::total_cmp).1);
     let (raw, mut source) = match clip {
         Some(h) if rest_height < REST_UPRIGHT * h => (
             h,

@@ -56,15 +56,29 @@ fn kernel_cos(x: f64, y: f64) -> f64 {
     w + (((1.0 - w) - hz) + (z * r - x * y))
 }
 
-/// `(sin x, cos x)`.
+/// `(sin x, cos x)`, one at a time (the reference for [`half_angles_sin_cos`]).
+#[cfg(test)]
 #[must_use]
-#[inline]
 pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
-    if x.is_nan() || x.abs() >= REDUCE_MAX {
-        return x.sin_cos();
+    if in_range(x) {
+        reduced_sin_cos(x)
+    } else {
+        x.sin_cos()
     }
-    // Round to nearest by the 1.5·2⁵² trick (`f64::round` is a libm call without SSE4.1).
-    let n = (x * INV_PIO2 + ROUNDER) - ROUNDER;
+}
+
+#[inline]
+fn in_range(x: f64) -> bool {
+    x.abs() < REDUCE_MAX
+}
+
+/// The fast path for `|x| < REDUCE_MAX`: no branches and no float-to-integer conversion, so a
+/// loop over it vectorizes with SSE2.
+#[inline]
+fn reduced_sin_cos(x: f64) -> (f64, f64) {
+    // Round to nearest by the 1.5·2⁵² trick: the low bits of `shifted` hold n mod 4.
+    let shifted = x * INV_PIO2 + ROUNDER;
+    let n = shifted - ROUNDER;
     let r = x - n * PIO2_1; // exact: n has at most 20 bits, PIO2_1 33
     let w = n * PIO2_1T;
     let head = r - w;
@@ -72,12 +86,31 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
     let (s, c) = (kernel_sin(head, tail), kernel_cos(head, tail));
     // Quadrant q: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s). Branch-free: the quadrant
     // of a joint angle is data, and a mispredicted branch costs as much as the polynomials.
-    let q = n as i64 as u64;
+    let q = shifted.to_bits();
     let swap = 0u64.wrapping_sub(q & 1);
     let (s, c) = (s.to_bits(), c.to_bits());
     let sin = (s & !swap) | (c & swap);
     let cos = (c & !swap) | (s & swap);
     (f64::from_bits(sin ^ ((q & 2) << 62)), f64::from_bits(cos ^ (((q + 1) & 2) << 62)))
+}
+
+/// `sin` and `cos` of half of every angle in `degrees` (converted as `f64::to_radians`), into
+/// `sin` and `cos`. One tight loop the compiler vectorizes, then a scalar pass for the rare
+/// huge or non-finite argument.
+pub(crate) fn half_angles_sin_cos(degrees: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    let n = degrees.len().min(sin.len()).min(cos.len());
+    let (values, sin, cos) = (&degrees[..n], &mut sin[..n], &mut cos[..n]);
+    for i in 0..n {
+        let (s, c) = reduced_sin_cos(values[i].to_radians() / 2.0);
+        sin[i] = s;
+        cos[i] = c;
+    }
+    for i in 0..n {
+        let x = values[i].to_radians() / 2.0;
+        if !in_range(x) {
+            (sin[i], cos[i]) = x.sin_cos();
+        }
+    }
 }
 
 #[cfg(test)]
@@ -111,6 +144,17 @@ mod tests {
                 x.sin()
             );
             assert!((c - x.cos()).abs() < 3e-16, "cos {x}: {c} vs {}", x.cos());
+        }
+    }
+
+    #[test]
+    fn the_row_version_is_the_scalar_one() {
+        let values = [0.0, 45.0, -179.9, 360.0, 1e9, f64::NAN, f64::INFINITY, -1234.5, 90.0];
+        let (mut sin, mut cos) = ([0.0; 9], [0.0; 9]);
+        half_angles_sin_cos(&values, &mut sin, &mut cos);
+        for (i, v) in values.iter().enumerate() {
+            let (s, c) = sin_cos(v.to_radians() / 2.0);
+            assert_eq!((s.to_bits(), c.to_bits()), (sin[i].to_bits(), cos[i].to_bits()), "{v}");
         }
     }
 }
