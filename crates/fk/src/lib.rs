@@ -82,13 +82,15 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     Ok((motion, report))
 }
 
+/// `1 / Frame Time`, snapped to the integer N when the Frame Time is 1/N rounded to a few
+/// decimals (LAFAN1's `0.033333` is 30 fps, not 30.0003; CMU's `.0083333` is 120).
 fn frames_per_second(bvh: &Bvh) -> Result<f64, Error> {
     let t = bvh.motion.frame_time;
-    if t.is_finite() && t > 0.0 {
-        Ok(1.0 / t)
-    } else {
-        Err(Error::BadFrameTime(t))
+    if !(t.is_finite() && t > 0.0) {
+        return Err(Error::BadFrameTime(t));
     }
+    let n = (1.0 / t).round();
+    Ok(if n >= 1.0 && (t * n - 1.0).abs() < 1e-4 { n } else { 1.0 / t })
 }
 
 fn positive(name: &'static str, value: f64) -> Result<f64, Error> {
@@ -531,6 +533,21 @@ mod tests {
         let (_, report) = human_motion(&bvh, &options).unwrap();
         assert_eq!((report.metres_per_unit, report.height), (0.5, 1.7));
         assert!(report.unit_reason.starts_with("forced"));
+    }
+
+    #[test]
+    fn fps_snaps_to_the_integer_the_frame_time_rounds() {
+        let mut bvh = tpose(Vec::new());
+        for (t, fps) in [
+            (0.033333, 30.0),
+            (0.0083333, 120.0),
+            (0.008333, 120.0),
+            (0.04, 25.0),
+            (0.3, 1.0 / 0.3),
+        ] {
+            bvh.motion.frame_time = t;
+            assert_eq!(frames_per_second(&bvh).unwrap(), fps, "{t}");
+        }
     }
 
     #[test]

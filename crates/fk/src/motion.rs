@@ -12,6 +12,8 @@ use crate::Error;
 /// `orientations` belongs to `body` at `frame`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HumanMotion {
+    /// Frames per second: `1 / Frame Time`, snapped to an integer when the file's Frame Time
+    /// is that integer's reciprocal rounded (`0.033333` → 30).
     pub fps: f64,
     pub body_names: Vec<String>,
     pub num_frames: usize,
