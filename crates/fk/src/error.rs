@@ -25,6 +25,9 @@ pub enum Error {
     /// The motion matrix does not hold `num_frames × num_channels` values.
     #[error("motion has {len} values, expected {num_frames} frames × {num_channels} channels")]
     MotionShape { len: usize, num_frames: usize, num_channels: usize },
+    /// Frames without channels: nothing moves, and the frame count bounds nothing.
+    #[error("the motion has {0} frames but no channels")]
+    NoChannels(usize),
     #[error("frame time must be a positive finite number of seconds, got {0}")]
     BadFrameTime(f64),
     /// NaN or infinity in the motion data.

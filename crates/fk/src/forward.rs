@@ -45,6 +45,9 @@ impl Plan {
                 num_channels: motion.num_channels,
             });
         }
+        if motion.num_channels == 0 && motion.num_frames > 0 {
+            return Err(Error::NoChannels(motion.num_frames));
+        }
         let joints = skeleton
             .joints
             .iter()

@@ -2,12 +2,25 @@
 //! Z up, quaternions w-first and continuous in time. This is the unit and axis boundary of
 //! the toolkit: everything downstream is metres and Z up.
 //!
-//! The numbers follow GMR's LAFAN1 loader operation by operation (see `forward`), so the
-//! targets built from them match GMR's to rounding. Where we differ on purpose: End Sites
-//! are bodies too (`<Parent>_End`), orientations are made continuous on the world
-//! quaternions (GMR does it on the local ones: same rotations, possibly other signs), units
-//! are chosen from the skeleton instead of assumed to be centimetres, and the subject height
-//! is measured instead of assumed to be 1.75 m.
+//! ```text
+//! human_motion(&bvh, &FkOptions::default()) -> (HumanMotion, FkReport)
+//! ```
+//!
+//! The numbers follow GMR's LAFAN1 loader operation by operation (`forward`, `math`): local
+//! `q = q(c₁) ⊗ (q(c₂) ⊗ q(c₃))` in each joint's channel order, position channels replace
+//! OFFSET, `q = q_parent ⊗ q_local`, `p = q_parent · p_local + p_parent`; world
+//! `p' = (x, −z, y) / 100` and `q' = q_x90 ⊗ q` for a Y-up centimetre file. Where we differ on
+//! purpose:
+//! - End Sites are bodies too (`<Parent>_End`);
+//! - orientations are made continuous on the world quaternions (GMR does it on the local
+//!   ones: same rotations, possibly opposite signs; compare up to sign);
+//! - units are chosen from the skeleton's size instead of assumed to be centimetres
+//!   ([`UnitChoice`], reported in [`FkReport::unit_reason`]);
+//! - the subject height is measured instead of assumed to be 1.75 m: head over the lowest
+//!   foot point in the rest pose when it stands upright, otherwise the 99th percentile over
+//!   the clip's frames, plus the skull for skeletons that end at the head joint
+//!   ([`FkReport::height_source`]);
+//! - `fps` is snapped to the integer a rounded Frame Time stands for (`0.033333` → 30).
 //!
 //! `fk` does no IO, never prints and never panics on input.
 
