@@ -1,20 +1,87 @@
 //! `retarget bvh …`: inspect, export and rewrite BVH files.
 
-use std::path::PathBuf;
+use std::fs::File;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::Subcommand;
 
 #[derive(Subcommand, Debug)]
 pub enum BvhCommand {
     /// Print a summary: frames, frame time, FPS, duration, joints as a tree, channels.
     Info { file: PathBuf },
+    /// Export as JSON: frame count, frame time and the joint tree with each joint's motion.
+    Json {
+        file: PathBuf,
+        /// Write here (atomically) instead of to standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Parse and write back (shortest round-trip numbers): a normalised, checked copy.
+    Cat {
+        file: PathBuf,
+        /// Write here (atomically) instead of to standard output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
 }
 
 pub fn run(cmd: BvhCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         BvhCommand::Info { file } => {
-            anyhow::bail!("{}: bvh info is not implemented yet", file.display())
+            let bvh = bvh::from_path(&file)?;
+            let summary = bvh::Summary::new(&bvh, &file.display().to_string());
+            emit(None, |w| write!(w, "{summary}"))?;
+        }
+        BvhCommand::Json { file, output } => {
+            let bvh = bvh::from_path(&file)?;
+            emit(output.as_deref(), |w| bvh::write_json(&bvh, w))?;
+        }
+        BvhCommand::Cat { file, output } => {
+            let bvh = bvh::from_path(&file)?;
+            emit(output.as_deref(), |w| bvh::write(&bvh, w))?;
         }
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Write to `output` atomically, or to standard output when it is `None`. A closed pipe
+/// (`retarget bvh json walk.bvh | head`) is not an error.
+fn emit(
+    output: Option<&Path>,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> anyhow::Result<()> {
+    match output {
+        Some(path) => write_atomically(path, write),
+        None => {
+            let mut stdout = io::stdout().lock();
+            match write(&mut stdout).and_then(|()| stdout.flush()) {
+                Err(e) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+                result => result.context("writing to standard output"),
+            }
+        }
+    }
+}
+
+/// Write `OUT.tmp-<pid>` beside `path`, then rename it over `path`: an interrupted or failed
+/// run leaves no half-written output.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> anyhow::Result<()> {
+    let name = path.file_name().with_context(|| format!("{}: not a file name", path.display()))?;
+    let mut tmp_name = name.to_os_string();
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = File::create(&tmp).and_then(|mut file| {
+        write(&mut file)?;
+        file.sync_all()
+    });
+    let result = result.and_then(|()| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("{}: cannot write", path.display()))
 }
