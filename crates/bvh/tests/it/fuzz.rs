@@ -10,7 +10,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
 use crate::{assert_round_trip, fixture_dir, shared_bvh_files};
 
-const CASES: u32 = 4000;
+const CASES: u32 = 20_000;
 
 /// Tokens worth inserting: structure, numbers at the edges, separators.
 const DICTIONARY: &[&str] = &[
