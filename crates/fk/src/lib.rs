@@ -39,7 +39,7 @@ pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
 use bvh::Bvh;
 use nalgebra::Vector3;
 
-use forward::{Plan, Scale, ToWorld};
+use forward::{Plan, ToWorld};
 use size::Landmarks;
 
 /// What [`human_motion`] decided and measured, for reports and for the retargeter.
@@ -69,11 +69,7 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
         positive("height", h)?;
     }
 
-    let world = ToWorld {
-        matrix: options.axes.world_from_file_matrix(),
-        quat: math::from_unit(&options.axes.world_from_file()),
-        scale: Scale::from_metres_per_unit(metres_per_unit),
-    };
+    let world = ToWorld::new(&options.axes, metres_per_unit);
     let num_frames = bvh.motion.num_frames;
     let num_joints = plan.num_joints();
     let sources: Vec<(usize, usize)> =
@@ -203,6 +199,7 @@ fn rest_pose(plan: &Plan, world: &ToWorld) -> Vec<Vector3<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::forward::Scale;
     use bvh::{Axis, Channel, Joint, JointId, JointKind, Motion, Skeleton};
     use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
     use rand::{Rng, SeedableRng};
