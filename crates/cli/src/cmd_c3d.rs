@@ -57,7 +57,7 @@ pub fn run(cmd: C3dCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         C3dCommand::Info { file } => {
             let c3d = read(&file)?;
-            print!("{}", info(&file, &c3d));
+            to_stdout(info(&file, &c3d).as_bytes())?;
         }
         C3dCommand::Dump { file, what, output } => {
             let c3d = read(&file)?;
@@ -181,10 +181,18 @@ fn dump(c: &C3d, what: &DumpWhat, output: Option<&Path>) -> anyhow::Result<()> {
     };
     match output {
         Some(path) => crate::atomic_write(path, text.as_bytes()),
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            stdout.write_all(text.as_bytes()).context("cannot write to stdout")
+        None => to_stdout(text.as_bytes()),
+    }
+}
+
+/// Writes to stdout; a closed pipe (`| head`) is not an error.
+fn to_stdout(bytes: &[u8]) -> anyhow::Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout.write_all(bytes).and_then(|()| stdout.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("cannot write to stdout")
         }
+        _ => Ok(()),
     }
 }
 
