@@ -44,8 +44,31 @@ const DICTIONARY: &[&str] = &[
     ":",
 ];
 
+/// Numbers that stress the float parser and the writer when swapped in for a file's own.
+const NUMBERS: &[&str] = &[
+    "-0",
+    "0.1",
+    "5e-324",
+    "4.9e-324",
+    "2.2250738585072014e-308",
+    "1.7976931348623157e308",
+    "9007199254740993",
+    "123456789012345678901234567890",
+    "0.30000000000000004",
+    "1e22",
+    "1e23",
+    "-1.5E+2",
+    ".5",
+    "7.",
+    "+3",
+    "1e-400",
+    "0.000000000000000000000000001",
+];
+
 #[derive(Debug, Clone)]
 enum Mutation {
+    /// Replace one number of the file (keeps most files valid: exercises the round trip).
+    Number(Index, &'static str),
     Flip(Index, u8),
     Delete(Index, usize),
     Insert(Index, Vec<u8>),
@@ -58,6 +81,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         prop::collection::vec(any::<u8>(), 1..4),
     ];
     prop_oneof![
+        3 => (any::<Index>(), prop::sample::select(NUMBERS)).prop_map(|(i, n)| Mutation::Number(i, n)),
         3 => (any::<Index>(), 0u8..8).prop_map(|(i, bit)| Mutation::Flip(i, 1 << bit)),
         3 => (any::<Index>(), 1usize..12).prop_map(|(i, n)| Mutation::Delete(i, n)),
         3 => (any::<Index>(), token).prop_map(|(i, t)| Mutation::Insert(i, t)),
@@ -70,6 +94,13 @@ fn apply(mut bytes: Vec<u8>, mutations: &[Mutation]) -> Vec<u8> {
         let len = bytes.len();
         match m {
             _ if len == 0 => {}
+            Mutation::Number(i, number) => {
+                let numbers = number_spans(&bytes);
+                if !numbers.is_empty() {
+                    let (start, end) = numbers[i.index(numbers.len())];
+                    bytes.splice(start..end, number.bytes());
+                }
+            }
             Mutation::Flip(i, bit) => bytes[i.index(len)] ^= bit,
             Mutation::Delete(i, n) => {
                 let at = i.index(len);
@@ -83,6 +114,26 @@ fn apply(mut bytes: Vec<u8>, mutations: &[Mutation]) -> Vec<u8> {
         }
     }
     bytes
+}
+
+/// Byte ranges of the whitespace-separated tokens that are numbers.
+fn number_spans(bytes: &[u8]) -> Vec<(usize, usize)> {
+    let mut spans = Vec::new();
+    let mut start = None;
+    for (i, &b) in bytes.iter().chain(b" ").enumerate() {
+        match (b.is_ascii_whitespace() || b == 0x0b, start) {
+            (false, None) => start = Some(i),
+            (true, Some(s)) => {
+                let token = std::str::from_utf8(&bytes[s..i]).unwrap_or("x");
+                if token.parse::<f64>().is_ok_and(f64::is_finite) {
+                    spans.push((s, i));
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    spans
 }
 
 /// The head of a real file, and its hierarchy plus the first two rows with `Frames: 2`.
