@@ -4,6 +4,7 @@
 #[path = "../../../../tests/support/shared.rs"]
 mod shared;
 
+mod cross_shared;
 mod fuzz;
 mod read_shared;
 mod write;

@@ -227,7 +227,7 @@ fn c3dio_reads_what_we_write() {
 }
 
 /// Runs `scripts/check-c3d-python` (Python `c3d` 0.6.0 in a venv under `target/`).
-fn python_c3d(files: &[PathBuf]) -> Option<serde_json::Value> {
+pub fn python_c3d(files: &[PathBuf]) -> Option<serde_json::Value> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scripts/check-c3d-python");
     let in_ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false");
     let has_python = std::process::Command::new("python3").arg("--version").output().is_ok();
@@ -240,7 +240,7 @@ fn python_c3d(files: &[PathBuf]) -> Option<serde_json::Value> {
     Some(serde_json::from_slice(&out.stdout).unwrap())
 }
 
-fn assert_python_frame(theirs: &serde_json::Value, ours: &C3d, frame: usize, what: &str) {
+pub fn assert_python_frame(theirs: &serde_json::Value, ours: &C3d, frame: usize, what: &str) {
     let f32_at = |v: &serde_json::Value| v.as_f64().map(|x| x as f32);
     let points = theirs["points"].as_array().unwrap();
     assert_eq!(points.len(), ours.points.point_count(), "{what}");
