@@ -93,8 +93,8 @@ struct TaskWork {
     dofs: Vec<usize>,
     /// Error at the current configuration.
     err: nalgebra::Vector6<f64>,
-    /// Weighted Jacobian, 6 × dofs.len(), row-major.
-    wjac: Vec<f64>,
+    /// Weighted Jacobian, one 6-column per dof of `dofs`.
+    wjac: Vec<[f64; 6]>,
 }
 
 /// A range-limited hinge or slide joint: its dof, qpos address and range.
@@ -154,7 +154,7 @@ impl<'m> Solver<'m> {
                 tasks.push(TaskWork {
                     spec: *spec,
                     cost: [p, p, p, r, r, r],
-                    wjac: vec![0.0; 6 * dofs.len()],
+                    wjac: vec![[0.0; 6]; dofs.len()],
                     dofs,
                     err: nalgebra::Vector6::zeros(),
                 });
@@ -170,6 +170,8 @@ impl<'m> Solver<'m> {
                 j.range.map(|range| Limit { joint: i, dof: j.dof_adr, qpos: j.qpos_adr, range })
             })
             .collect();
+        let mut qp = BoxQp::new(nv);
+        qp.set_tree(dof_parents(model));
         let mut solver = Solver {
             model,
             options,
@@ -182,7 +184,7 @@ impl<'m> Solver<'m> {
             dq: vec![0.0; nv],
             jacp: vec![0.0; 3 * nv],
             jacr: vec![0.0; 3 * nv],
-            qp: BoxQp::new(nv),
+            qp,
             qp_failures: 0,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
@@ -284,6 +286,9 @@ impl<'m> Solver<'m> {
         }
         for d in 0..nv {
             self.qp.h[d * nv + d] += self.options.damping + mu_total;
+            for e in 0..d {
+                self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
+            }
         }
         self.set_bounds(dt);
         let status = self.qp.solve();
@@ -307,32 +312,23 @@ impl<'m> Solver<'m> {
         let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &frame));
         self.model.jac_body(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
-        let m = task.dofs.len();
         let task = &mut self.stages[s][k];
-        for (col, &d) in task.dofs.iter().enumerate() {
+        for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
             let jp = nalgebra::Vector3::new(self.jacp[d], self.jacp[nv + d], self.jacp[2 * nv + d]);
             let jr = nalgebra::Vector3::new(self.jacr[d], self.jacr[nv + d], self.jacr[2 * nv + d]);
             let (bp, br) = (rt * jp, rt * jr);
             let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
             let j = -(jlog * local);
-            for r in 0..6 {
-                task.wjac[r * m + col] = task.cost[r] * j[r];
-            }
+            *col = std::array::from_fn(|r| task.cost[r] * j[r]);
         }
         let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
-        for (a, &da) in task.dofs.iter().enumerate() {
-            let mut c = 0.0;
-            for (r, w) in we.iter().enumerate() {
-                c += w * task.wjac[r * m + a];
-            }
-            self.qp.c[da] -= c;
-            for (b, &db) in task.dofs.iter().enumerate() {
-                let mut h = 0.0;
-                for r in 0..6 {
-                    h += task.wjac[r * m + a] * task.wjac[r * m + b];
-                }
-                self.qp.h[da * nv + db] += h;
+        // Upper triangle only (dofs ascending); `step` mirrors it.
+        for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
+            self.qp.c[da] -= dot6(&we, col_a);
+            let row = &mut self.qp.h[da * nv..(da + 1) * nv];
+            for (col_b, &db) in task.wjac[a..].iter().zip(&task.dofs[a..]) {
+                row[db] += dot6(col_a, col_b);
             }
         }
         self.options.lm_damping * mu
@@ -395,6 +391,18 @@ impl<'m> Solver<'m> {
     }
 }
 
+/// Parent of every dof in MuJoCo's dof tree, from the bodies' dof chains.
+fn dof_parents(model: &Model) -> Vec<Option<usize>> {
+    let mut parent = vec![None; model.nv];
+    for body in 0..model.nbody() {
+        let chain: Vec<usize> = model.body_dofs(body).collect();
+        for pair in chain.windows(2) {
+            parent[pair[0]] = Some(pair[1]);
+        }
+    }
+    parent
+}
+
 fn check_options(o: &SolverOptions) -> Result<(), Error> {
     let ok = o.damping.is_finite()
         && o.damping > 0.0
@@ -409,4 +417,9 @@ fn check_options(o: &SolverOptions) -> Result<(), Error> {
     } else {
         Err(Error::InvalidOption(format!("solver options out of range: {o:?}")))
     }
+}
+
+#[inline]
+fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 }
