@@ -1,1 +1,605 @@
-//! Motion quality metrics.
+//! Quality metrics of a robot motion: how well it tracked its targets, whether it respects
+//! joint limits, how fast and how smooth the joints move, and how the feet meet the ground.
+//!
+//! Definitions (T frames at `fps`, Δt = 1/fps; all positions from forward kinematics):
+//!
+//! - **Statistics** `mean`, `p95`, `p99`, `max` are over frames; percentiles interpolate
+//!   linearly between closest ranks (numpy's default `linear` method).
+//! - **Tracking error** (when the motion has targets), per target body: position error
+//!   `|xpos − target_pos|` (m) and rotation error, the angle of `xquat⁻¹ · target_quat` (rad,
+//!   in [0, π]).
+//! - **Joint limits**: a limited hinge or slide joint violates its range in a frame when
+//!   `q < lo − tol` or `q > hi + tol` ([`ReportOptions::limit_tolerance`]); the count is over
+//!   frames × joints, the excess is `max(lo − q, q − hi)`.
+//! - **Joint velocity** `q̇` and **jitter**: `q̇` with numpy's `gradient` scheme (central
+//!   differences inside, one-sided at the ends); jitter is the mean over interior frames of
+//!   `|q[t+1] − 2 q[t] + q[t−1]| / Δt²` (rad/s² or m/s²). Hinge and slide joints only.
+//! - **Feet**: the foot height `h` in a frame is the lowest point of the foot's primitive
+//!   collision geoms (sphere, capsule, cylinder, ellipsoid, box on the foot body or its
+//!   descendants) above the ground plane `z = ground_height`, or the height of the foot body's
+//!   origin when it has none. The foot's horizontal velocity `v` is the `gradient` of its body
+//!   origin's x, y. A frame is a **contact** frame when `h < contact_height` and
+//!   `|v| < contact_speed`; a contact frame **slides** when `|v| > slide_speed`. The
+//!   **sliding share** is sliding frames / contact frames. A **contact phase** is a maximal run
+//!   of consecutive contact frames; its **sliding distance** is the horizontal path length of
+//!   the foot origin between consecutive frames of the phase (reported in cm, mean and max
+//!   over phases). **Penetration** in a frame is `max(0, −h)` (cm).
+//! - **Floating**: a frame floats when both feet have `h ≥ contact_height`; the floating
+//!   height of a frame is `max(0, min(h_left, h_right))` (cm).
+//! - **Root height**: z of the first body (the floating base), m.
+
+use std::fmt;
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::motion::RobotMotion;
+use crate::writers::{body_poses, check_motion, gradient_rows, BodyPoses, Error};
+
+/// Tunables of [`report`]; see the module documentation for the definitions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReportOptions {
+    /// Foot bodies `[left, right]`; `None`: `left_ankle_roll_link` / `right_ankle_roll_link`
+    /// if the model has them, else on each side the lowest body (at `qpos0`) whose name has
+    /// `ankle` or `foot` and a side marker (`left`, `l_`, `_l`; `right`, `r_`, `_r`).
+    pub feet: Option<[String; 2]>,
+    /// Height of the ground plane (m). Default 0.
+    pub ground_height: f64,
+    /// Contact needs the foot's lowest point below this height (m). Default 0.03.
+    pub contact_height: f64,
+    /// Contact needs a horizontal foot speed below this (m/s). Default 1.0.
+    pub contact_speed: f64,
+    /// A contact frame slides above this horizontal foot speed (m/s). Default 0.1.
+    pub slide_speed: f64,
+    /// Joint speed limit to count frames against (rad/s or m/s), if any. Default none.
+    pub joint_velocity_limit: Option<f64>,
+    /// Slack before a joint counts as outside its range (rad or m). Default 1e-6.
+    pub limit_tolerance: f64,
+}
+
+impl Default for ReportOptions {
+    fn default() -> Self {
+        ReportOptions {
+            feet: None,
+            ground_height: 0.0,
+            contact_height: 0.03,
+            contact_speed: 1.0,
+            slide_speed: 0.1,
+            joint_velocity_limit: None,
+            limit_tolerance: 1e-6,
+        }
+    }
+}
+
+/// Mean, 95th percentile and maximum over frames.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stats {
+    pub mean: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+/// Tracking error of one target body.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BodyTracking {
+    pub body: String,
+    /// Position error (m).
+    pub pos_m: Stats,
+    /// Rotation error (rad).
+    pub rot_rad: Stats,
+}
+
+/// Joint-limit violations of one joint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LimitViolation {
+    pub joint: String,
+    pub frames: usize,
+    /// Largest distance outside the range (rad or m).
+    pub max_excess: f64,
+}
+
+/// Joint-limit summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointLimits {
+    /// Frames × joints outside their range.
+    pub violations: usize,
+    pub max_excess: f64,
+    /// Only the joints that violate.
+    pub joints: Vec<LimitViolation>,
+}
+
+/// Speed and smoothness of one hinge or slide joint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointMotion {
+    pub joint: String,
+    /// 99th percentile of `|q̇|`.
+    pub vel_p99: f64,
+    pub vel_max: f64,
+    /// Frames with `|q̇|` above [`ReportOptions::joint_velocity_limit`] (0 without a limit).
+    pub vel_over_limit: usize,
+    /// Mean `|q̈|` (rad/s² or m/s²).
+    pub jitter: f64,
+}
+
+/// Ground contact of one foot.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FootReport {
+    pub body: String,
+    /// `"geoms"` (lowest point of its collision geoms) or `"origin"` (body origin).
+    pub height_from: &'static str,
+    pub contact_frames: usize,
+    pub contact_phases: usize,
+    pub sliding_frames: usize,
+    /// Sliding frames / contact frames (0 without contact).
+    pub sliding_share: f64,
+    pub slide_per_phase_cm_mean: f64,
+    pub slide_per_phase_cm_max: f64,
+    /// Frames with the foot below the ground.
+    pub penetration_frames: usize,
+    pub penetration_cm_max: f64,
+    /// Mean over the penetrating frames (0 without any).
+    pub penetration_cm_mean: f64,
+}
+
+/// Frames with neither foot near the ground.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Floating {
+    pub frames: usize,
+    pub share: f64,
+    /// Mean over all frames of `max(0, lowest foot height)` (cm).
+    pub cm_mean: f64,
+    pub cm_max: f64,
+}
+
+/// Min, mean and max.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Range {
+    pub min: f64,
+    pub mean: f64,
+    pub max: f64,
+}
+
+/// The quality report of one motion (serialises to JSON; `Display` prints a table).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct QualityReport {
+    pub robot: String,
+    pub frames: usize,
+    pub fps: f64,
+    /// Per target body, when the motion has targets.
+    pub tracking: Option<Vec<BodyTracking>>,
+    pub joint_limits: JointLimits,
+    pub joints: Vec<JointMotion>,
+    pub feet: Vec<FootReport>,
+    pub floating: Floating,
+    /// Root height (m).
+    pub root_height: Range,
+}
+
+/// Computes the [`QualityReport`] of `motion` on `model` (the robot it was solved for).
+pub fn report(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    opts: &ReportOptions,
+) -> Result<QualityReport, Error> {
+    check_motion(motion, model)?;
+    let feet = match &opts.feet {
+        Some([l, r]) => [named_body(model, l)?, named_body(model, r)?],
+        None => detect_feet(model)?,
+    };
+    let poses = body_poses(motion, model);
+    let frames = motion.num_frames();
+    let heights = feet.map(|f| foot_heights(motion, model, f, opts.ground_height));
+    let feet_reports: Vec<FootReport> = (0..2)
+        .map(|i| foot_report(model, &poses, feet[i], &heights[i].0, heights[i].1, motion.fps, opts))
+        .collect();
+    let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
+    Ok(QualityReport {
+        robot: model.name.clone(),
+        frames,
+        fps: motion.fps,
+        tracking: tracking(motion, model, &poses)?,
+        joint_limits: joint_limits(motion, model, opts.limit_tolerance),
+        joints: joint_motion(motion, model, opts.joint_velocity_limit),
+        feet: feet_reports,
+        floating: floating(&heights[0].0, &heights[1].0, opts.contact_height),
+        root_height: range(&root),
+    })
+}
+
+fn named_body(model: &mjcf::Model, name: &str) -> Result<usize, Error> {
+    model
+        .body_id(name)
+        .filter(|&b| b > 0)
+        .ok_or_else(|| Error::Options(format!("no body named \"{name}\" in the robot model")))
+}
+
+/// The two foot bodies `[left, right]` (see [`ReportOptions::feet`]).
+pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
+    if let (Some(l), Some(r)) =
+        (model.body_id("left_ankle_roll_link"), model.body_id("right_ankle_roll_link"))
+    {
+        return Ok([l, r]);
+    }
+    let mut data = mjcf::Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
+    let side = |markers: [&str; 3], prefix: &str| {
+        let candidates = model.bodies.iter().enumerate().skip(1).filter(|(_, b)| {
+            let n = b.name.to_ascii_lowercase();
+            (n.contains("ankle") || n.contains("foot"))
+                && (n.contains(markers[0])
+                    || n.starts_with(prefix)
+                    || n.contains(markers[1])
+                    || n.ends_with(markers[2]))
+        });
+        // Lowest at qpos0; the later (deeper) body on ties.
+        candidates
+            .map(|(i, _)| i)
+            .min_by(|&a, &b| data.xpos[a].z.total_cmp(&data.xpos[b].z).then(b.cmp(&a)))
+    };
+    match (side(["left", "_l_", "_l"], "l_"), side(["right", "_r_", "_r"], "r_")) {
+        (Some(l), Some(r)) if l != r => Ok([l, r]),
+        _ => Err(Error::Options(
+            "cannot find the two foot bodies by name (ankle/foot, left/right): name them".into(),
+        )),
+    }
+}
+
+/// Per frame foot height above the ground, and whether it comes from geoms.
+fn foot_heights(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    foot: usize,
+    ground: f64,
+) -> (Vec<f64>, bool) {
+    let in_foot = |mut b: usize| loop {
+        if b == foot {
+            return true;
+        }
+        if b == 0 {
+            return false;
+        }
+        b = model.bodies[b].parent;
+    };
+    let geoms: Vec<usize> = (0..model.geoms.len())
+        .filter(|&g| {
+            in_foot(model.geoms[g].body)
+                && lowest_offset(&model.geoms[g], &nalgebra::Matrix3::identity()).is_some()
+        })
+        .collect();
+    let mut data = mjcf::Data::new(model);
+    let heights = (0..motion.num_frames())
+        .map(|t| {
+            model.kinematics(motion.frame(t), &mut data);
+            let lowest = geoms
+                .iter()
+                .filter_map(|&g| {
+                    let off = lowest_offset(&model.geoms[g], &data.geom_xmat[g])?;
+                    Some(data.geom_xpos[g].z - off)
+                })
+                .fold(f64::INFINITY, f64::min);
+            if lowest.is_finite() {
+                lowest
+            } else {
+                data.xpos[foot].z
+            }
+        })
+        .map(|z| z - ground)
+        .collect();
+    (heights, !geoms.is_empty())
+}
+
+/// How far below its centre a primitive geom reaches, given its world orientation `r`
+/// (support function along −z); `None` for planes, height fields, meshes and SDFs.
+fn lowest_offset(geom: &mjcf::Geom, r: &nalgebra::Matrix3<f64>) -> Option<f64> {
+    let [a, b, c] = geom.size;
+    // Row z of the rotation: the world z of each local axis.
+    let z = Vector3::new(r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+    Some(match geom.kind {
+        mjcf::GeomType::Sphere => a,
+        mjcf::GeomType::Capsule => a + b * z.z.abs(),
+        mjcf::GeomType::Cylinder => a * (1.0 - z.z * z.z).max(0.0).sqrt() + b * z.z.abs(),
+        mjcf::GeomType::Ellipsoid => {
+            ((a * z.x).powi(2) + (b * z.y).powi(2) + (c * z.z).powi(2)).sqrt()
+        }
+        mjcf::GeomType::Box => a * z.x.abs() + b * z.y.abs() + c * z.z.abs(),
+        _ => return None,
+    })
+}
+
+fn foot_report(
+    model: &mjcf::Model,
+    poses: &BodyPoses,
+    foot: usize,
+    heights: &[f64],
+    from_geoms: bool,
+    fps: f64,
+    opts: &ReportOptions,
+) -> FootReport {
+    let frames = heights.len();
+    let xy: Vec<f64> = (0..frames)
+        .flat_map(|t| {
+            let p = poses.pos(t, foot - 1);
+            [p.x, p.y]
+        })
+        .collect();
+    let vel = gradient_rows(&xy, 2, 1.0 / fps);
+    let speed: Vec<f64> = vel.chunks_exact(2).map(|v| v[0].hypot(v[1])).collect();
+    let contact: Vec<bool> = (0..frames)
+        .map(|t| heights[t] < opts.contact_height && speed[t] < opts.contact_speed)
+        .collect();
+    let contact_frames = contact.iter().filter(|c| **c).count();
+    let sliding_frames = (0..frames).filter(|&t| contact[t] && speed[t] > opts.slide_speed).count();
+    let mut slides = Vec::new();
+    let mut t = 0;
+    while t < frames {
+        if !contact[t] {
+            t += 1;
+            continue;
+        }
+        let mut dist = 0.0;
+        while t + 1 < frames && contact[t + 1] {
+            dist += (xy[2 * t + 2] - xy[2 * t]).hypot(xy[2 * t + 3] - xy[2 * t + 1]);
+            t += 1;
+        }
+        slides.push(dist * 100.0);
+        t += 1;
+    }
+    let penetration: Vec<f64> = heights.iter().filter(|h| **h < 0.0).map(|h| -h * 100.0).collect();
+    FootReport {
+        body: model.bodies[foot].name.clone(),
+        height_from: if from_geoms { "geoms" } else { "origin" },
+        contact_frames,
+        contact_phases: slides.len(),
+        sliding_frames,
+        sliding_share: ratio(sliding_frames, contact_frames),
+        slide_per_phase_cm_mean: mean(&slides),
+        slide_per_phase_cm_max: slides.iter().copied().fold(0.0, f64::max),
+        penetration_frames: penetration.len(),
+        penetration_cm_max: penetration.iter().copied().fold(0.0, f64::max),
+        penetration_cm_mean: mean(&penetration),
+    }
+}
+
+fn floating(left: &[f64], right: &[f64], contact_height: f64) -> Floating {
+    let lowest: Vec<f64> = left.iter().zip(right).map(|(l, r)| l.min(*r)).collect();
+    let frames = lowest.iter().filter(|h| **h >= contact_height).count();
+    let cm: Vec<f64> = lowest.iter().map(|h| h.max(0.0) * 100.0).collect();
+    Floating {
+        frames,
+        share: ratio(frames, lowest.len()),
+        cm_mean: mean(&cm),
+        cm_max: cm.iter().copied().fold(0.0, f64::max),
+    }
+}
+
+fn tracking(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    poses: &BodyPoses,
+) -> Result<Option<Vec<BodyTracking>>, Error> {
+    let Some(targets) = &motion.targets else { return Ok(None) };
+    let k = targets.body_names.len();
+    let mut out = Vec::with_capacity(k);
+    for (j, name) in targets.body_names.iter().enumerate() {
+        let b = named_body(model, name)? - 1;
+        let (mut pos, mut rot) = (Vec::new(), Vec::new());
+        for t in 0..motion.num_frames() {
+            pos.push((poses.pos(t, b) - targets.pos[t * k + j]).norm());
+            rot.push(poses.quat(t, b).angle_to(&targets.quat[t * k + j]));
+        }
+        out.push(BodyTracking { body: name.clone(), pos_m: stats(&pos), rot_rad: stats(&rot) });
+    }
+    Ok(Some(out))
+}
+
+/// Limited hinge and slide joints: `(joint index, qpos address)`.
+fn scalar_joints(model: &mjcf::Model) -> impl Iterator<Item = (usize, usize)> + '_ {
+    model.joints.iter().enumerate().filter_map(|(j, joint)| {
+        matches!(joint.kind, mjcf::JointType::Hinge | mjcf::JointType::Slide)
+            .then_some((j, joint.qpos_adr))
+    })
+}
+
+fn joint_limits(motion: &RobotMotion, model: &mjcf::Model, tol: f64) -> JointLimits {
+    let mut joints = Vec::new();
+    for (j, a) in scalar_joints(model) {
+        let Some([lo, hi]) = model.joints[j].range else { continue };
+        let excess: Vec<f64> = (0..motion.num_frames())
+            .map(|t| {
+                let q = motion.frame(t)[a];
+                (lo - q).max(q - hi)
+            })
+            .filter(|e| *e > tol)
+            .collect();
+        if !excess.is_empty() {
+            joints.push(LimitViolation {
+                joint: model.joints[j].name.clone(),
+                frames: excess.len(),
+                max_excess: excess.iter().copied().fold(0.0, f64::max),
+            });
+        }
+    }
+    JointLimits {
+        violations: joints.iter().map(|v| v.frames).sum(),
+        max_excess: joints.iter().map(|v| v.max_excess).fold(0.0, f64::max),
+        joints,
+    }
+}
+
+fn joint_motion(motion: &RobotMotion, model: &mjcf::Model, limit: Option<f64>) -> Vec<JointMotion> {
+    let frames = motion.num_frames();
+    scalar_joints(model)
+        .map(|(j, a)| {
+            let q: Vec<f64> = (0..frames).map(|t| motion.frame(t)[a]).collect();
+            let speed: Vec<f64> =
+                gradient_rows(&q, 1, 1.0 / motion.fps).iter().map(|v| v.abs()).collect();
+            let acc: Vec<f64> = q
+                .windows(3)
+                .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs() * motion.fps * motion.fps)
+                .collect();
+            JointMotion {
+                joint: model.joints[j].name.clone(),
+                vel_p99: percentile(&speed, 0.99),
+                vel_max: speed.iter().copied().fold(0.0, f64::max),
+                vel_over_limit: limit.map_or(0, |l| speed.iter().filter(|s| **s > l).count()),
+                jitter: mean(&acc),
+            }
+        })
+        .collect()
+}
+
+fn ratio(a: usize, b: usize) -> f64 {
+    if b == 0 {
+        0.0
+    } else {
+        a as f64 / b as f64
+    }
+}
+
+fn mean(x: &[f64]) -> f64 {
+    if x.is_empty() {
+        0.0
+    } else {
+        x.iter().sum::<f64>() / x.len() as f64
+    }
+}
+
+/// numpy's `percentile(x, 100 p)` with linear interpolation; 0 for no data.
+fn percentile(x: &[f64], p: f64) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let mut s = x.to_vec();
+    s.sort_by(f64::total_cmp);
+    let pos = p * (s.len() - 1) as f64;
+    let (i, frac) = (pos.floor() as usize, pos - pos.floor());
+    let next = s[(i + 1).min(s.len() - 1)];
+    s[i] + (next - s[i]) * frac
+}
+
+fn stats(x: &[f64]) -> Stats {
+    Stats { mean: mean(x), p95: percentile(x, 0.95), max: x.iter().copied().fold(0.0, f64::max) }
+}
+
+fn range(x: &[f64]) -> Range {
+    Range {
+        min: x.iter().copied().fold(f64::INFINITY, f64::min),
+        mean: mean(x),
+        max: x.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    }
+}
+
+impl fmt::Display for QualityReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let secs = self.frames as f64 / self.fps;
+        writeln!(
+            f,
+            "robot {} · {} frames at {} fps ({secs:.2} s)",
+            self.robot, self.frames, self.fps
+        )?;
+        if let Some(tracking) = &self.tracking {
+            writeln!(f, "\ntracking error           position (cm) mean / p95 / max   rotation (rad) mean / p95 / max")?;
+            for b in tracking {
+                let (p, r) = (b.pos_m, b.rot_rad);
+                writeln!(
+                    f,
+                    "  {:<24} {:>7.2} {:>7.2} {:>7.2}          {:>7.3} {:>7.3} {:>7.3}",
+                    b.body,
+                    p.mean * 100.0,
+                    p.p95 * 100.0,
+                    p.max * 100.0,
+                    r.mean,
+                    r.p95,
+                    r.max
+                )?;
+            }
+        }
+        let l = &self.joint_limits;
+        writeln!(
+            f,
+            "\njoint limits: {} violations (frames × joints), max excess {:.4}",
+            l.violations, l.max_excess
+        )?;
+        for v in &l.joints {
+            writeln!(
+                f,
+                "  {:<28} {:>5} frames, max excess {:.4}",
+                v.joint, v.frames, v.max_excess
+            )?;
+        }
+        writeln!(
+            f,
+            "\njoint                          |q̇| p99    |q̇| max  over limit   jitter |q̈| mean"
+        )?;
+        for j in &self.joints {
+            writeln!(
+                f,
+                "  {:<28} {:>8.3} {:>10.3} {:>11} {:>17.2}",
+                j.joint, j.vel_p99, j.vel_max, j.vel_over_limit, j.jitter
+            )?;
+        }
+        writeln!(f, "\nfoot                      height   contact  phases  sliding  slide/phase cm mean/max  penetration cm mean/max (frames)")?;
+        for foot in &self.feet {
+            writeln!(
+                f,
+                "  {:<24} {:<7} {:>7} {:>7} {:>7.1}%      {:>6.2} / {:<6.2}        {:.2} / {:.2} ({})",
+                foot.body,
+                foot.height_from,
+                foot.contact_frames,
+                foot.contact_phases,
+                foot.sliding_share * 100.0,
+                foot.slide_per_phase_cm_mean,
+                foot.slide_per_phase_cm_max,
+                foot.penetration_cm_mean,
+                foot.penetration_cm_max,
+                foot.penetration_frames
+            )?;
+        }
+        let fl = &self.floating;
+        writeln!(
+            f,
+            "\nfloating: {} frames ({:.1}%), lowest foot above ground mean {:.2} cm, max {:.2} cm",
+            fl.frames,
+            fl.share * 100.0,
+            fl.cm_mean,
+            fl.cm_max
+        )?;
+        let r = self.root_height;
+        writeln!(f, "root height (m): min {:.3}, mean {:.3}, max {:.3}", r.min, r.mean, r.max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentile_is_numpys_linear() {
+        // numpy.percentile([1, 2, 3, 4], 95) = 3.85
+        assert!((percentile(&[4.0, 1.0, 3.0, 2.0], 0.95) - 3.85).abs() < 1e-12);
+        assert_eq!(percentile(&[7.0], 0.99), 7.0);
+        assert_eq!(percentile(&[], 0.5), 0.0);
+    }
+
+    #[test]
+    fn box_and_capsule_reach_down() {
+        let mut geom = mjcf::Geom {
+            name: String::new(),
+            body: 1,
+            kind: mjcf::GeomType::Box,
+            size: [0.1, 0.2, 0.3],
+            pos: Vector3::zeros(),
+            quat: nalgebra::UnitQuaternion::identity(),
+            mesh: None,
+        };
+        let id = nalgebra::Matrix3::identity();
+        assert_eq!(lowest_offset(&geom, &id), Some(0.3));
+        let tilted =
+            *nalgebra::Rotation3::from_euler_angles(std::f64::consts::FRAC_PI_2, 0.0, 0.0).matrix();
+        assert!((lowest_offset(&geom, &tilted).unwrap() - 0.2).abs() < 1e-12);
+        geom.kind = mjcf::GeomType::Capsule;
+        assert!((lowest_offset(&geom, &id).unwrap() - 0.3).abs() < 1e-12);
+        geom.kind = mjcf::GeomType::Mesh;
+        assert_eq!(lowest_offset(&geom, &id), None);
+    }
+}

@@ -1,0 +1,78 @@
+//! `retarget report MOTION.npz`: quality metrics of a retargeted motion (see
+//! `retarget::report` for the definitions), as a table and optionally as JSON.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use retarget::report::{report, ReportOptions};
+use retarget::writers::{read_motion_npz, read_npz_robot};
+
+use crate::shipped;
+
+#[derive(clap::Args, Debug)]
+pub struct ReportArgs {
+    /// A motion written by `retarget` (.npz).
+    pub motion: PathBuf,
+    /// Robot (shipped name or MJCF path); default: the `robot` name stored in the .npz.
+    #[arg(long)]
+    pub robot: Option<String>,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "OUT.json")]
+    pub json: Option<PathBuf>,
+    /// Foot bodies, left then right (default: the ankle/foot bodies found by name).
+    #[arg(long, num_args = 2, value_names = ["LEFT", "RIGHT"])]
+    pub feet: Option<Vec<String>>,
+    /// Height of the ground plane (m).
+    #[arg(long, default_value_t = ReportOptions::default().ground_height)]
+    pub ground: f64,
+    /// Contact: foot lowest point below this height (m).
+    #[arg(long, default_value_t = ReportOptions::default().contact_height)]
+    pub contact_height: f64,
+    /// Contact: horizontal foot speed below this (m/s).
+    #[arg(long, default_value_t = ReportOptions::default().contact_speed)]
+    pub contact_speed: f64,
+    /// A contact frame slides above this horizontal foot speed (m/s).
+    #[arg(long, default_value_t = ReportOptions::default().slide_speed)]
+    pub slide_speed: f64,
+    /// Count frames with a joint speed above this (rad/s).
+    #[arg(long)]
+    pub velocity_limit: Option<f64>,
+}
+
+pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
+    let motion = read_motion_npz(&args.motion)?;
+    let model = match &args.robot {
+        Some(robot) => shipped::robot_model(robot)?,
+        None => {
+            let stored = read_npz_robot(&args.motion)?.with_context(|| {
+                format!("{}: no robot name stored; pass --robot", args.motion.display())
+            })?;
+            shipped::robot_model(&stored).with_context(|| {
+                format!("{}: stored robot \"{stored}\"; pass --robot", args.motion.display())
+            })?
+        }
+    };
+    let robot = if model.name.is_empty() { "(unnamed)" } else { model.name.as_str() };
+    let opts = ReportOptions {
+        feet: args.feet.map(|f| [f[0].clone(), f[1].clone()]),
+        ground_height: args.ground,
+        contact_height: args.contact_height,
+        contact_speed: args.contact_speed,
+        slide_speed: args.slide_speed,
+        joint_velocity_limit: args.velocity_limit,
+        ..ReportOptions::default()
+    };
+    let rep = report(&motion, &model, &opts)
+        .with_context(|| format!("{}: robot {robot}", args.motion.display()))?;
+    if let Some(path) = &args.json {
+        let mut text = serde_json::to_string_pretty(&rep)?;
+        text.push('\n');
+        crate::atomic_write(path, text.as_bytes())?;
+    }
+    match std::io::stdout().lock().write_all(rep.to_string().as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(ExitCode::SUCCESS),
+    }
+}
