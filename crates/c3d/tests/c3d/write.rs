@@ -302,3 +302,23 @@ fn python_c3d_reads_what_we_write() {
         assert_python_frame(&theirs["last"], ours, n - 1, &format!("{what} last frame"));
     }
 }
+
+#[test]
+fn more_than_255_points_and_channels_use_continuation_parameters() {
+    let labels: Vec<String> = (0..300).map(|i| format!("M{i:03}")).collect();
+    let channels: Vec<String> = (0..260).map(|i| format!("A{i}")).collect();
+    let mut c = C3d::new(50.0);
+    c.points = Points::new(labels.clone(), 2);
+    c.points.set(1, 299, Some(Point { position: [1.0, 2.0, 3.0], residual: 0.0, cameras: 1 }));
+    c.analog = Analog::new(channels.clone(), 100.0, 2, 2);
+    c.analog.set(3, 259, 4.5);
+    for format in [Format::INTEL_FLOAT, Format::INTEL_INT] {
+        let back = reread(&to_bytes(&c, format));
+        assert!(back.parameters.get("POINT", "LABELS2").is_some());
+        assert!(back.parameters.get("ANALOG", "SCALE2").is_some());
+        assert_eq!(back.point_labels(), &labels[..]);
+        assert_eq!(back.analog.labels, channels);
+        assert_eq!(back.points.get(1, 299).map(|p| p.position), Some([1.0, 2.0, 3.0]));
+        assert_eq!(back.analog.get(3, 259), Some(4.5));
+    }
+}
