@@ -1,0 +1,189 @@
+//! The project's data types → the page's plain data ([`super::Scene`] parts).
+
+use super::{
+    JointKind, PointFigure, PointStyle, RobotBody, RobotFigure, RobotGeom, RobotJoint, Shape,
+};
+use anyhow::{ensure, Context};
+
+pub const HUMAN_COLOR: [f32; 3] = [0.93, 0.52, 0.2];
+pub const TARGET_COLOR: [f32; 3] = [0.18, 0.68, 0.3];
+
+// (nalgebra is not a dependency of this crate: the types are reached through the others.)
+macro_rules! xyz {
+    ($v:expr) => {{
+        let v = $v;
+        [v.x, v.y, v.z]
+    }};
+}
+
+macro_rules! wxyz {
+    ($q:expr) => {{
+        let q = $q;
+        [q.w, q.i, q.j, q.k]
+    }};
+}
+
+fn push_f32(out: &mut Vec<f32>, values: &[f64]) {
+    #[allow(clippy::cast_possible_truncation)] // float32 is the page's storage format
+    out.extend(values.iter().map(|&v| v as f32));
+}
+
+/// A robot motion on its model. The page poses the robot from `qpos` itself; three frames of
+/// world body positions from [`mjcf::Model::kinematics`] travel along as a check.
+pub fn robot_figure(model: &mjcf::Model, qpos: &[f64], label: &str) -> anyhow::Result<RobotFigure> {
+    let nq = model.nq;
+    ensure!(
+        qpos.len().checked_rem(nq) == Some(0),
+        "{label}: qpos length {} is not a multiple of nq = {nq}",
+        qpos.len()
+    );
+    let frames = qpos.len() / nq;
+    let body = |id: usize| id.checked_sub(1); // world (0) is implicit in the page
+    let bodies = model.bodies.iter().skip(1).map(|b| RobotBody {
+        name: b.name.clone(),
+        parent: body(b.parent),
+        pos: xyz!(b.pos),
+        quat: wxyz!(b.quat),
+    });
+    let joints = model.joints.iter().filter_map(|j| {
+        Some(RobotJoint {
+            name: j.name.clone(),
+            kind: match j.kind {
+                mjcf::JointType::Free => JointKind::Free,
+                mjcf::JointType::Ball => JointKind::Ball,
+                mjcf::JointType::Slide => JointKind::Slide,
+                mjcf::JointType::Hinge => JointKind::Hinge,
+            },
+            body: body(j.body)?,
+            qpos_adr: j.qpos_adr,
+            axis: xyz!(j.axis),
+            pos: xyz!(j.pos),
+            range: j.range,
+        })
+    });
+    let geoms = model.geoms.iter().filter_map(|g| {
+        let shape = match g.kind {
+            mjcf::GeomType::Sphere => Shape::Sphere,
+            mjcf::GeomType::Capsule => Shape::Capsule,
+            mjcf::GeomType::Cylinder => Shape::Cylinder,
+            mjcf::GeomType::Box => Shape::Box,
+            mjcf::GeomType::Ellipsoid => Shape::Ellipsoid,
+            _ => return None, // planes, meshes, height fields: bones stand in for them
+        };
+        Some(RobotGeom {
+            body: body(g.body)?,
+            shape,
+            size: g.size,
+            pos: xyz!(g.pos),
+            quat: wxyz!(g.quat),
+        })
+    });
+    let names: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+    let mut data = mjcf::Data::new(model);
+    let mut check = Vec::new();
+    for frame in [0, frames / 2, frames.saturating_sub(1)] {
+        if frames == 0 || check.iter().any(|c: &(usize, Vec<[f64; 3]>)| c.0 == frame) {
+            continue;
+        }
+        model.kinematics(&qpos[frame * nq..(frame + 1) * nq], &mut data);
+        check.push((frame, data.xpos.iter().skip(1).map(|p| xyz!(p)).collect()));
+    }
+    let mut qpos32 = Vec::with_capacity(qpos.len());
+    push_f32(&mut qpos32, qpos);
+    Ok(RobotFigure {
+        label: label.to_owned(),
+        bodies: bodies.collect(),
+        joints: joints.collect(),
+        geoms: geoms.collect(),
+        nq,
+        qpos0: model.qpos0.clone(),
+        qpos: qpos32,
+        feet: super::find_feet(&names),
+        check,
+    })
+}
+
+/// Check that a robot motion belongs to `model`: same `nq` and, when the motion names its
+/// joints, the same non-free joints in the same order.
+pub fn check_motion_fits(
+    model: &mjcf::Model,
+    motion: &retarget::RobotMotion,
+) -> anyhow::Result<()> {
+    ensure!(
+        motion.nq == model.nq,
+        "the motion has nq = {} but the robot model has nq = {}",
+        motion.nq,
+        model.nq
+    );
+    if !motion.joint_names.is_empty() {
+        let model_joints: Vec<&str> = model
+            .joints
+            .iter()
+            .filter(|j| j.kind != mjcf::JointType::Free)
+            .map(|j| j.name.as_str())
+            .collect();
+        let motion_joints: Vec<&str> = motion.joint_names.iter().map(String::as_str).collect();
+        ensure!(model_joints == motion_joints, "the motion's joints differ from the robot model's");
+    }
+    Ok(())
+}
+
+/// The IK targets a robot motion tracked, as spheres with orientation axes.
+pub fn targets_figure(
+    targets: &retarget::TrackedTargets,
+    num_frames: usize,
+) -> anyhow::Result<PointFigure> {
+    let k = targets.body_names.len();
+    ensure!(targets.pos.len() == num_frames * k, "targets: positions are not frames × bodies");
+    ensure!(
+        targets.quat.is_empty() || targets.quat.len() == num_frames * k,
+        "targets: orientations are not frames × bodies"
+    );
+    let mut positions = Vec::with_capacity(num_frames * k * 3);
+    for p in &targets.pos {
+        push_f32(&mut positions, &xyz!(p));
+    }
+    let mut orientations = Vec::with_capacity(targets.quat.len() * 4);
+    for q in &targets.quat {
+        push_f32(&mut orientations, &wxyz!(q));
+    }
+    Ok(PointFigure {
+        label: "IK targets".to_owned(),
+        style: PointStyle::Targets,
+        color: TARGET_COLOR,
+        names: targets.body_names.clone(),
+        parents: vec![None; k],
+        positions,
+        orientations,
+        feet: vec![],
+    })
+}
+
+/// A skeleton figure from world positions of points with parents (`positions[frame * n + i]`).
+pub fn skeleton_figure(
+    label: &str,
+    names: &[String],
+    parents: &[Option<usize>],
+    positions: impl Iterator<Item = [f64; 3]>,
+) -> PointFigure {
+    let mut flat = Vec::new();
+    for p in positions {
+        push_f32(&mut flat, &p);
+    }
+    PointFigure {
+        label: label.to_owned(),
+        style: PointStyle::Skeleton,
+        color: HUMAN_COLOR,
+        names: names.to_vec(),
+        parents: parents.to_vec(),
+        positions: flat,
+        orientations: vec![],
+        feet: super::find_feet(names),
+    }
+}
+
+/// A model read for its geometry only (used by tests before a real MJCF is at hand).
+#[allow(dead_code)]
+pub fn model_from_xml(xml: &str) -> anyhow::Result<mjcf::Model> {
+    mjcf::Model::from_xml_str(xml, None).context("robot model")
+}
