@@ -71,13 +71,32 @@ fn feet_are_the_ankle_roll_links() {
     assert_eq!(model.bodies[r].name, "right_ankle_roll_link");
 }
 
+/// Our shipped G1 (box soles; needs no reference data).
+fn repo_g1() -> mjcf::Model {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../robots/unitree_g1/unitree_g1.xml");
+    mjcf::Model::from_file(&path).expect("robots/unitree_g1 compiles")
+}
+
 #[test]
 fn a_known_foot_slide_is_measured() {
-    let Some(model) = g1() else { return };
+    if let Some(model) = g1() {
+        check_known_slide(&model);
+    }
+}
+
+#[test]
+fn a_known_foot_slide_is_measured_with_box_soles() {
+    let model = repo_g1();
+    assert!(model.geom_id("left_sole").is_some());
+    check_known_slide(&model);
+}
+
+fn check_known_slide(model: &mjcf::Model) {
     let speed = 0.3;
-    let (motion, xs) = sliding_motion(&model, speed, 0.001);
+    let (motion, xs) = sliding_motion(model, speed, 0.001);
     let opts = ReportOptions::default();
-    let rep = report(&motion, &model, &opts).unwrap();
+    let rep = report(&motion, model, &opts).unwrap();
     // Central differences: a frame's foot speed is (x[t+1] − x[t−1]) · fps / 2.
     let speeds: Vec<f64> = (0..FRAMES)
         .map(|t| {
@@ -102,11 +121,11 @@ fn a_known_foot_slide_is_measured() {
     assert!((rep.floating.cm_max - 0.1).abs() < 1e-9, "{:?}", rep.floating);
     // A higher sliding threshold leaves only the full-speed frames.
     let strict = ReportOptions { slide_speed: 0.2, ..ReportOptions::default() };
-    let rep = report(&motion, &model, &strict).unwrap();
+    let rep = report(&motion, model, &strict).unwrap();
     assert_eq!(rep.feet[0].sliding_frames, 19);
     // Too fast for contact (above contact_speed): the sliding frames stop being contact.
     let loose = ReportOptions { contact_speed: 0.2, ..ReportOptions::default() };
-    let rep = report(&motion, &model, &loose).unwrap();
+    let rep = report(&motion, model, &loose).unwrap();
     assert_eq!(rep.feet[0].contact_frames, FRAMES - 19);
     assert_eq!(rep.feet[0].contact_phases, 2);
 }

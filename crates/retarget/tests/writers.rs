@@ -2,9 +2,6 @@
 //! Python + numpy through `scripts/check-outputs-python`, and compared with forward kinematics
 //! and with velocities known in closed form.
 
-#[path = "../../../tests/support/shared.rs"]
-mod shared;
-
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -21,9 +18,10 @@ const FRAMES: usize = 20;
 const ROOT_VEL: [f64; 3] = [0.4, -0.2, 0.05];
 const ROOT_ANG_VEL: [f64; 3] = [0.3, -0.5, 1.1];
 
+/// Our shipped G1 (`robots/unitree_g1`, kinematics equal to GMR's; no reference data needed).
 fn g1() -> Option<mjcf::Model> {
-    let path = shared::shared_file("reference/robots/unitree_g1/g1_mocap_29dof.xml")?;
-    Some(mjcf::Model::from_file(&path).expect("the reference G1 compiles"))
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/unitree_g1/unitree_g1.xml");
+    Some(mjcf::Model::from_file(&path).expect("robots/unitree_g1 compiles"))
 }
 
 fn scratch_dir(name: &str) -> PathBuf {
