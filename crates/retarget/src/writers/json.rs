@@ -24,46 +24,47 @@ pub(crate) fn write_json<W: Write>(
     motion: &RobotMotion,
     model: &mjcf::Model,
 ) -> std::io::Result<()> {
-    let head = json!({
-        "format": "retarget-motion",
-        "version": 1,
-        "robot": model.name,
-        "conventions": {
-            "up": "z",
-            "length": "m",
-            "angle": "rad",
-            "quaternion": "w x y z",
-            "qpos": "MuJoCo layout: free root x y z qw qx qy qz, then joints in MJCF order",
-        },
-        "fps": motion.fps,
-        "nq": motion.nq,
-        "num_frames": motion.num_frames(),
-        "joint_names": motion.joint_names,
-        "body_names": motion.body_names,
+    let conventions = json!({
+        "up": "z",
+        "length": "m",
+        "angle": "rad",
+        "quaternion": "w x y z",
+        "qpos": "MuJoCo layout: free root x y z qw qx qy qz, then joints in MJCF order",
     });
-    let head = serde_json::to_string_pretty(&head)?;
-    // Everything but the closing brace, then the per-frame arrays one row per line.
-    let head = head.trim_end().strip_suffix('}').unwrap_or(&head).trim_end();
-    writeln!(out, "{head},")?;
+    let head = [
+        ("format", json!("retarget-motion")),
+        ("version", json!(1)),
+        ("robot", json!(model.name)),
+        ("conventions", conventions),
+        ("fps", json!(motion.fps)),
+        ("nq", json!(motion.nq)),
+        ("num_frames", json!(motion.num_frames())),
+        ("joint_names", json!(motion.joint_names)),
+        ("body_names", json!(motion.body_names)),
+    ];
+    writeln!(out, "{{")?;
+    for (key, value) in head {
+        writeln!(out, "  \"{key}\": {},", serde_json::to_string(&value)?)?;
+    }
     let frames = motion.num_frames();
-    write_rows(out, "qpos", (0..frames).map(|t| serde_json::to_string(motion.frame(t))))?;
+    write_rows(out, "  ", "qpos", (0..frames).map(|t| serde_json::to_string(motion.frame(t))))?;
     match &motion.targets {
         None => writeln!(out, ",\n  \"targets\": null")?,
         Some(targets) => {
             let k = targets.body_names.len();
             writeln!(out, ",\n  \"targets\": {{")?;
-            writeln!(out, "  \"body_names\": {},", serde_json::to_string(&targets.body_names)?)?;
+            writeln!(out, "    \"body_names\": {},", serde_json::to_string(&targets.body_names)?)?;
             let pos_rows = (0..frames).map(|t| {
                 let row = &targets.pos[t * k..(t + 1) * k];
                 serde_json::to_string(&row.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>())
             });
-            write_rows(out, "pos", pos_rows)?;
+            write_rows(out, "    ", "pos", pos_rows)?;
             writeln!(out, ",")?;
             let quat_rows = (0..frames).map(|t| {
                 let row = &targets.quat[t * k..(t + 1) * k];
                 serde_json::to_string(&row.iter().map(|q| [q.w, q.i, q.j, q.k]).collect::<Vec<_>>())
             });
-            write_rows(out, "quat", quat_rows)?;
+            write_rows(out, "    ", "quat", quat_rows)?;
             writeln!(out, "\n  }}")?;
         }
     }
@@ -71,17 +72,18 @@ pub(crate) fn write_json<W: Write>(
     Ok(())
 }
 
-/// `  "key": [\n    row,\n    row\n  ]` (no trailing newline).
+/// `<indent>"key": [\n<indent>  row,\n<indent>  row\n<indent>]` (no trailing newline).
 fn write_rows<W: Write>(
     out: &mut W,
+    indent: &str,
     key: &str,
     rows: impl Iterator<Item = serde_json::Result<String>>,
 ) -> std::io::Result<()> {
-    write!(out, "  \"{key}\": [")?;
+    write!(out, "{indent}\"{key}\": [")?;
     for (i, row) in rows.enumerate() {
         let sep = if i == 0 { "" } else { "," };
-        write!(out, "{sep}\n    {}", row?)?;
+        write!(out, "{sep}\n{indent}  {}", row?)?;
     }
-    write!(out, "\n  ]")?;
+    write!(out, "\n{indent}]")?;
     Ok(())
 }
