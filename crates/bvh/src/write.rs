@@ -29,12 +29,8 @@ pub fn write(bvh: &Bvh, out: impl Write) -> io::Result<()> {
         }
     }
     let motion = &bvh.motion;
-    writeln!(
-        w,
-        "MOTION\nFrames: {}\nFrame Time: {}",
-        motion.num_frames,
-        num.format(motion.frame_time)
-    )?;
+    let frame_time = short(&mut num, motion.frame_time);
+    writeln!(w, "MOTION\nFrames: {}\nFrame Time: {frame_time}", motion.num_frames)?;
     let columns = tree.columns(bvh);
     for frame in 0..motion.num_frames {
         let row = motion.frame(frame);
@@ -42,11 +38,18 @@ pub fn write(bvh: &Bvh, out: impl Write) -> io::Result<()> {
             if i > 0 {
                 w.write_all(b" ")?;
             }
-            w.write_all(num.format(row[c]).as_bytes())?;
+            w.write_all(short(&mut num, row[c]).as_bytes())?;
         }
         w.write_all(b"\n")?;
     }
     w.flush()
+}
+
+/// ryu's shortest round-trip form without a trailing `.0` (`90`, not `90.0`): the same
+/// number, as exporters write it. `v` must be finite (checked before writing).
+fn short(num: &mut ryu::Buffer, v: f64) -> &str {
+    let text = num.format_finite(v);
+    text.strip_suffix(".0").unwrap_or(text)
 }
 
 fn write_joint_head(
@@ -62,7 +65,7 @@ fn write_joint_head(
     }
     write!(w, "{indent}\tOFFSET")?;
     for v in joint.offset {
-        write!(w, " {}", num.format(v))?;
+        write!(w, " {}", short(num, v))?;
     }
     writeln!(w)?;
     if joint.kind != JointKind::End {
