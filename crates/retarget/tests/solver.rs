@@ -1,0 +1,204 @@
+//! Solver behaviour on the shipped and reference models: recovering poses made by the
+//! robot's own FK, joint limits, config checks on real names, every shipped config against
+//! its robot and the LAFAN1 skeleton.
+
+#[path = "../../../tests/support/shared.rs"]
+mod shared;
+
+use std::path::{Path, PathBuf};
+
+use mjcf::{Data, JointType, Model};
+use nalgebra::Vector3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use retarget::lie::{mat_to_quat, Pose};
+use retarget::{IkConfig, Solver, SolverOptions, TaskSpec};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn g1() -> Model {
+    Model::from_file(&repo().join("robots/unitree_g1/unitree_g1.xml")).unwrap()
+}
+
+/// A random configuration near `qpos0` (±`spread` rad per hinge) with every limited joint at
+/// least 5 % of its span inside its range.
+fn random_pose(model: &Model, rng: &mut ChaCha8Rng, spread: f64) -> Vec<f64> {
+    let mut q = model.qpos0.clone();
+    for j in &model.joints {
+        if let (JointType::Hinge, Some([lo, hi])) = (j.kind, j.range) {
+            let m = 0.05 * (hi - lo);
+            let v = q[j.qpos_adr] + rng.gen_range(-spread..spread);
+            q[j.qpos_adr] = v.clamp(lo + m, hi - m);
+        }
+    }
+    q
+}
+
+fn poses_of(model: &Model, q: &[f64], bodies: &[usize]) -> Vec<Pose> {
+    let mut data = Data::new(model);
+    model.kinematics(q, &mut data);
+    bodies.iter().map(|&b| Pose { quat: mat_to_quat(&data.xmat[b]), pos: data.xpos[b] }).collect()
+}
+
+/// Targets made by the model's own FK at an in-range pose are recovered when iterated to
+/// convergence (no stop threshold, many frames on the same targets).
+#[test]
+fn recovers_own_fk_pose() {
+    let model = g1();
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let names = [
+        "pelvis",
+        "left_ankle_roll_link",
+        "right_ankle_roll_link",
+        "torso_link",
+        "left_wrist_yaw_link",
+        "right_wrist_yaw_link",
+        "left_knee_link",
+        "right_knee_link",
+        "left_elbow_link",
+        "right_elbow_link",
+        "left_hip_yaw_link",
+        "right_hip_yaw_link",
+        "left_shoulder_yaw_link",
+        "right_shoulder_yaw_link",
+    ];
+    let bodies: Vec<usize> = names.iter().map(|n| model.body_id(n).unwrap()).collect();
+    let tasks: Vec<TaskSpec> = bodies
+        .iter()
+        .enumerate()
+        .map(|(k, &body)| TaskSpec { body, target: k, pos_weight: 1.0, rot_weight: 1.0 })
+        .collect();
+    for _ in 0..3 {
+        let mut q = random_pose(&model, &mut rng, 0.5);
+        q[0] += 0.3;
+        q[1] -= 0.2;
+        let targets = poses_of(&model, &q, &bodies);
+        let options = SolverOptions { stop_threshold: -1.0, ..SolverOptions::default() };
+        let mut solver = Solver::new(&model, std::slice::from_ref(&tasks), options).unwrap();
+        let mut last = f64::INFINITY;
+        for _ in 0..300 {
+            last = solver.solve_frame(&targets, 1.0 / 30.0).error;
+        }
+        assert!(last < 1e-6, "remaining error {last}");
+        let back = poses_of(&model, solver.qpos(), &bodies);
+        for (a, b) in back.iter().zip(&targets) {
+            assert!((a.pos - b.pos).norm() < 1e-6);
+        }
+    }
+}
+
+/// An elbow target beyond the joint's range (upper arm and pelvis held) ends on the limit,
+/// never past it.
+#[test]
+fn out_of_range_target_stops_at_the_limit() {
+    let model = g1();
+    let elbow = model.joint_id("left_elbow_joint").unwrap();
+    let [lo, hi] = model.joints[elbow].range.unwrap();
+    let adr = model.joints[elbow].qpos_adr;
+    let mut q = model.qpos0.clone();
+    q[adr] = hi + 0.5;
+    let names = ["left_elbow_link", "left_shoulder_yaw_link", "pelvis"];
+    let bodies: Vec<usize> = names.iter().map(|n| model.body_id(n).unwrap()).collect();
+    let targets = poses_of(&model, &q, &bodies);
+    let tasks: Vec<TaskSpec> = bodies
+        .iter()
+        .enumerate()
+        .map(|(k, &body)| TaskSpec { body, target: k, pos_weight: 0.0, rot_weight: 10.0 })
+        .collect();
+    let mut solver = Solver::new(&model, &[tasks], SolverOptions::default()).unwrap();
+    let mut last = None;
+    for _ in 0..100 {
+        let d = solver.solve_frame(&targets, 1.0 / 30.0);
+        let qe = solver.qpos()[adr];
+        assert!(qe <= hi && qe >= lo, "elbow {qe} outside [{lo}, {hi}]");
+        last = Some(d);
+    }
+    let gap = hi - solver.qpos()[adr];
+    assert!(gap < 1e-6, "elbow stays {gap} below its limit");
+    assert!(last.unwrap().at_limit.contains(&elbow));
+}
+
+#[test]
+fn max_joint_speed_bounds_every_frame() {
+    let model = g1();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let q = random_pose(&model, &mut rng, 1.0);
+    let body = model.body_id("left_wrist_yaw_link").unwrap();
+    let targets = poses_of(&model, &q, &[body]);
+    let tasks = vec![TaskSpec { body, target: 0, pos_weight: 10.0, rot_weight: 10.0 }];
+    let options = SolverOptions { max_joint_speed: Some(1.0), ..SolverOptions::default() };
+    let mut solver = Solver::new(&model, &[tasks], options).unwrap();
+    for _ in 0..5 {
+        let before = solver.qpos().to_vec();
+        solver.solve_frame(&targets, 0.1);
+        for j in model.joints.iter().filter(|j| j.kind == JointType::Hinge) {
+            let moved = (solver.qpos()[j.qpos_adr] - before[j.qpos_adr]).abs();
+            assert!(moved <= 0.1 + 1e-12, "{} moved {moved}", j.name);
+        }
+    }
+}
+
+/// LAFAN1 skeleton body names (22 joints + End Sites + GMR's derived feet), from the take.
+fn lafan1_bodies() -> Option<Vec<String>> {
+    let path = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh")?;
+    let bvh = bvh::from_path(&path).unwrap();
+    let (human, _) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
+    Some(human.body_names)
+}
+
+#[test]
+fn every_shipped_config_fits_its_robot_and_lafan1() {
+    let Some(human) = lafan1_bodies() else { return };
+    let dir = repo().join("configs");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let Some(key) = name.strip_prefix("bvh_lafan1_to_").and_then(|n| n.strip_suffix(".json"))
+        else {
+            continue;
+        };
+        let model_path = repo().join(format!("robots/{key}/{key}.xml"));
+        let model = Model::from_file(&model_path).unwrap_or_else(|e| panic!("{key}: {e}"));
+        let config = IkConfig::from_file(&path).unwrap();
+        config.validate(&model, &human).unwrap_or_else(|e| panic!("{name}: {e}"));
+        count += 1;
+    }
+    assert!(count >= 6, "only {count} shipped configs");
+}
+
+#[test]
+fn unknown_names_are_located_with_suggestions() {
+    let Some(human) = lafan1_bodies() else { return };
+    let model = g1();
+    let text =
+        std::fs::read_to_string(repo().join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let bad = text.replace("\"left_knee_link\"", "\"left_kne_link\"");
+    let config = IkConfig::from_json_str(&bad, "g1.json").unwrap();
+    let err = config.validate(&model, &human).unwrap_err().to_string();
+    assert!(err.starts_with("g1.json:"), "{err}");
+    assert!(err.contains("unknown robot body `left_kne_link`"), "{err}");
+    assert!(err.contains("nearest: left_knee_link"), "{err}");
+    let bad = text.replace("\"LeftForeArm\"", "\"LeftForArm\"");
+    let config = IkConfig::from_json_str(&bad, "g1.json").unwrap();
+    let err = config.validate(&model, &human).unwrap_err().to_string();
+    assert!(
+        err.contains("unknown human body `LeftForArm`") && err.contains("LeftForeArm"),
+        "{err}"
+    );
+}
+
+#[test]
+fn positions_are_in_metres_not_nan() {
+    // Guard: a config with a NaN-free but absurd scale still solves without NaN.
+    let model = g1();
+    let body = model.body_id("pelvis").unwrap();
+    let target = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(1e3, -1e3, 1e3) };
+    let tasks = vec![TaskSpec { body, target: 0, pos_weight: 1.0, rot_weight: 1.0 }];
+    let mut solver = Solver::new(&model, &[tasks], SolverOptions::default()).unwrap();
+    let d = solver.solve_frame(&[target], 1.0 / 30.0);
+    assert!(solver.qpos().iter().all(|v| v.is_finite()));
+    assert_eq!(d.qp_failures, 0);
+}
