@@ -92,7 +92,8 @@ fn bvh_page_holds_every_joint_of_every_frame() {
     assert_eq!(skeleton["names"].as_array().unwrap().len(), nodes);
     assert_eq!(skeleton["names"][0], "Hips");
     assert!(skeleton["parents"][0].is_null());
-    assert_eq!(decoded_len(&skeleton["positions"]), frames * nodes * 3 * 4);
+    assert_eq!(decoded_len(&skeleton["root"]), frames * 3 * 4);
+    assert_eq!(decoded_len(&skeleton["offsets"]), frames * nodes * 3 * 2);
     let feet: Vec<&str> =
         skeleton["feet"].as_array().unwrap().iter().map(|f| f[0].as_str().unwrap()).collect();
     assert_eq!(feet, ["left", "right"]);
@@ -100,7 +101,7 @@ fn bvh_page_holds_every_joint_of_every_frame() {
     assert!(tree.starts_with("Hips\n  "), "{tree}");
     assert!(!tree.contains("_End"));
     // A few MB at most for a 4-minute clip: float32 positions in base64 and nothing else big.
-    assert!(html.len() < frames * nodes * 12 * 4 / 3 + 300_000, "{} bytes", html.len());
+    assert!(html.len() < frames * (nodes * 6 + 12) * 4 / 3 + 300_000, "{} bytes", html.len());
 }
 
 #[test]
@@ -200,7 +201,7 @@ fn robot_page_from_our_npz_names_its_robot_and_targets() {
     let targets = &scene["skeletons"][0];
     assert_eq!(targets["style"], "targets");
     assert_eq!(targets["names"].as_array().unwrap().len(), 3);
-    assert_eq!(decoded_len(&targets["positions"]), frames * 3 * 3 * 4);
+    assert_eq!(decoded_len(&targets["offsets"]), frames * 3 * 3 * 2);
     assert_eq!(decoded_len(&targets["orientations"]), frames * 3 * 4 * 2);
 }
 

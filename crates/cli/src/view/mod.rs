@@ -44,7 +44,9 @@ pub enum PointStyle {
 }
 
 /// A set of named points moving over time, optionally oriented and linked to parents.
+/// Serialised compactly: point 0 as float32, the others as int16 offsets from it.
 #[derive(Debug, Clone, Serialize)]
+#[serde(into = "PointFigureOut")]
 pub struct PointFigure {
     /// Label of the figure's toggle in the page.
     pub label: String,
@@ -55,13 +57,67 @@ pub struct PointFigure {
     /// Parent point of each point (bones), `None` for roots.
     pub parents: Vec<Option<usize>>,
     /// `[frame][point][xyz]`, metres, world frame (Z up).
-    #[serde(serialize_with = "f32_base64")]
     pub positions: Vec<f32>,
     /// `[frame][point][wxyz]`, world orientations; empty when unknown.
-    #[serde(serialize_with = "unit_i16_base64")]
     pub orientations: Vec<f32>,
     /// Indices of the points used for foot plots, with a label ("left", "right").
     pub feet: Vec<(String, usize)>,
+}
+
+/// [`PointFigure`] as the page reads it. Positions: `root` is point 0 per frame (float32);
+/// `offsets` is every point minus point 0 in units of `step` metres (int16), with `step`
+/// the smallest that fits the figure's largest offset (0.1 mm for a person).
+#[derive(Serialize)]
+struct PointFigureOut {
+    label: String,
+    style: PointStyle,
+    color: [f32; 3],
+    names: Vec<String>,
+    parents: Vec<Option<usize>>,
+    #[serde(serialize_with = "f32_base64")]
+    root: Vec<f32>,
+    step: f64,
+    #[serde(serialize_with = "i16_base64")]
+    offsets: Vec<i16>,
+    #[serde(serialize_with = "unit_i16_base64")]
+    orientations: Vec<f32>,
+    feet: Vec<(String, usize)>,
+}
+
+impl From<PointFigure> for PointFigureOut {
+    fn from(f: PointFigure) -> Self {
+        let n = f.names.len().max(1);
+        let frames: Vec<&[f32]> = f.positions.chunks(n * 3).collect();
+        let root: Vec<f32> = frames.iter().flat_map(|fr| fr[..3].to_vec()).collect();
+        let offset = |fr: &[f32], k: usize| f64::from(fr[k]) - f64::from(fr[k % 3]);
+        let widest = frames
+            .iter()
+            .flat_map(|fr| (0..fr.len()).map(|k| offset(fr, k).abs()))
+            .fold(0.0, f64::max);
+        let step = (widest / 32000.0).max(1e-4);
+        #[allow(clippy::cast_possible_truncation)] // |offset / step| <= 32000 by the choice of step
+        let offsets = frames
+            .iter()
+            .flat_map(|fr| (0..fr.len()).map(move |k| (offset(fr, k) / step).round() as i16))
+            .collect();
+        PointFigureOut {
+            label: f.label,
+            style: f.style,
+            color: f.color,
+            names: f.names,
+            parents: f.parents,
+            root,
+            step,
+            offsets,
+            orientations: f.orientations,
+            feet: f.feet,
+        }
+    }
+}
+
+fn i16_base64<S: Serializer>(values: &[i16], s: S) -> Result<S::Ok, S::Error> {
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    s.serialize_str(&base64::encode(&bytes))
 }
 
 /// A robot as its kinematic tree (MuJoCo's body/joint/geom arrays without the world body)
@@ -328,6 +384,29 @@ mod tests {
         let html = scene.to_html().unwrap();
         assert_eq!(html.matches("</script>").count(), html.matches("<script").count());
         assert!(html.contains("a&lt;/script&gt;&lt;b&gt;.bvh"));
+    }
+
+    #[test]
+    fn point_offsets_round_trip_within_half_a_step() {
+        let positions: Vec<f32> =
+            (0..2 * 3 * 3).map(|i| (i as f32 * 0.37).sin() * 1.9 + 5.0).collect();
+        let figure = PointFigure {
+            label: "p".into(),
+            style: PointStyle::Skeleton,
+            color: [1.0; 3],
+            names: names(&["a", "b", "c"]),
+            parents: vec![None, Some(0), Some(1)],
+            positions: positions.clone(),
+            orientations: vec![],
+            feet: vec![],
+        };
+        let out = PointFigureOut::from(figure);
+        assert!(out.step >= 1e-4 && out.step < 1e-3);
+        for (k, &p) in positions.iter().enumerate() {
+            let root = f64::from(out.root[k / 9 * 3 + k % 3]);
+            let back = root + f64::from(out.offsets[k]) * out.step;
+            assert!((back - f64::from(p)).abs() <= out.step / 2.0 + 1e-6, "{k}: {back} vs {p}");
+        }
     }
 
     #[test]

@@ -20,12 +20,20 @@
     for (let i = 0; i < s.length; i++) bytes[i] = s.charCodeAt(i);
     return new Float32Array(bytes.buffer);
   }
-  // Components of unit quaternions, stored as round(v * 32767) in int16.
-  function unitI16(b64) {
+  function i16(b64) {
     const s = atob(b64);
     const bytes = new Uint8Array(s.length);
     for (let i = 0; i < s.length; i++) bytes[i] = s.charCodeAt(i);
-    return Float32Array.from(new Int16Array(bytes.buffer), (v) => v / 32767);
+    return new Int16Array(bytes.buffer);
+  }
+  // Components of unit quaternions, stored as round(v * 32767) in int16.
+  const unitI16 = (b64) => Float32Array.from(i16(b64), (v) => v / 32767);
+  // Point positions: point 0 per frame in float32, the others as int16 offsets of `step` m.
+  function pointPositions(fig) {
+    const root = f32(fig.root), off = i16(fig.offsets), n = fig.names.length;
+    const out = new Float32Array(off.length);
+    for (let k = 0; k < off.length; k++) out[k] = root[Math.floor(k / (3 * n)) * 3 + (k % 3)] + off[k] * fig.step;
+    return out;
   }
 
   // ---------- math ----------
@@ -325,7 +333,7 @@
 
   const axesBuf = [];
   for (const fig of scene.skeletons) {
-    const pos = f32(fig.positions), rot = fig.orientations ? unitI16(fig.orientations) : new Float32Array(0);
+    const pos = pointPositions(fig), rot = fig.orientations ? unitI16(fig.orientations) : new Float32Array(0);
     const n = fig.names.length;
     const at = (f, i) => [pos[(f * n + i) * 3], pos[(f * n + i) * 3 + 1], pos[(f * n + i) * 3 + 2]];
     const rotAt = (f, i) => Array.from(rot.subarray((f * n + i) * 4, (f * n + i) * 4 + 4));
@@ -555,5 +563,6 @@
   if (statusEl.dataset.state !== 'error') {
     statusEl.dataset.state = 'ok';
     statusEl.textContent = 'ok';
+    statusEl.dataset.loadMs = Math.round(performance.now());
   }
 })();
