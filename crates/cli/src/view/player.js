@@ -380,7 +380,7 @@
   }
   function heading(text) { const h = document.createElement('h3'); h.textContent = text; plotsEl.append(h); }
   function addPlot(p, wide) {
-    const rows = p.series.length > 1 ? Math.ceil(p.series.length / 8) : 0;
+    const rows = p.series.length > 1 ? Math.ceil(p.series.length / 5) : 0;
     const W = wide ? 940 : 300, H = (wide ? 150 : 110) + 10 * rows, L = 44, Rm = 6, T = 16, B = 14 + 10 * rows;
     const svg = svgEl('svg', { width: W, height: H, class: 'plot' });
     svgEl('text', { x: L, y: 11, class: 'title' }, svg).textContent = p.title + (p.unit ? ' (' + p.unit + ')' : '');
@@ -409,7 +409,7 @@
       }
       const color = COLORS[si % COLORS.length];
       svgEl('path', { d, stroke: color }, svg);
-      if (p.series.length > 1) svgEl('text', { x: L + 4 + (si % 8) * ((W - L - 60) / 8), y: H - 3 - 10 * Math.floor(si / 8), style: 'fill:' + color }, svg).textContent = s.name;
+      if (p.series.length > 1) svgEl('text', { x: L + 4 + (si % 5) * ((W - L - 60) / 5), y: H - 3 - 10 * (rows - 1 - Math.floor(si / 5)), style: 'fill:' + color }, svg).textContent = s.name;
     });
     const cur = svgEl('line', { x1: L, x2: L, y1: T, y2: H - B, class: 'cursor' }, svg);
     cursors.push((f) => { const x = X(f); cur.setAttribute('x1', x); cur.setAttribute('x2', x); });
