@@ -235,6 +235,9 @@ pub fn python_c3d(files: &[PathBuf]) -> Option<serde_json::Value> {
         eprintln!("note: python3 is not installed; skipping the Python c3d cross-check");
         return None;
     }
+    // One caller at a time: the first one may be creating the venv.
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _guard = LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let out = std::process::Command::new(&script).args(files).output().unwrap();
     assert!(out.status.success(), "{}: {}", script.display(), String::from_utf8_lossy(&out.stderr));
     Some(serde_json::from_slice(&out.stdout).unwrap())
