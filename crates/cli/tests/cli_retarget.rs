@@ -1,0 +1,134 @@
+//! The main job: `retarget --bvh FILE --robot NAME [-o OUT] [--config C] [--human-height H]`.
+//! Uses the first 40 frames of the shared LAFAN1 walk take (`RETARGET_SHARED`).
+
+#[path = "../../../tests/support/shared.rs"]
+mod shared;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn retarget(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_retarget")).args(args).output().expect("runs retarget")
+}
+
+fn text(out: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh temporary folder for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cli_retarget_{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The walk take cut to its first `frames` frames, written to `dir/walk.bvh`.
+fn short_walk(dir: &Path, frames: usize) -> Option<PathBuf> {
+    let source = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh")?;
+    let full = std::fs::read_to_string(source).unwrap();
+    let (head, motion) = full.split_once("MOTION").unwrap();
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let _frames_line = lines.next().unwrap();
+    let frame_time = lines.next().unwrap();
+    let rows: Vec<&str> = lines.take(frames).collect();
+    let text = format!("{head}MOTION\nFrames: {frames}\n{frame_time}\n{}\n", rows.join("\n"));
+    let path = dir.join("walk.bvh");
+    std::fs::write(&path, text).unwrap();
+    Some(path)
+}
+
+#[test]
+fn writes_npz_next_to_the_input_and_prints_a_summary() {
+    let dir = temp_dir("npz");
+    let Some(bvh) = short_walk(&dir, 40) else { return };
+    let out = retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", "unitree_g1"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("40 frames at 30.000 fps"), "{stdout}");
+    assert!(stdout.contains("left_ankle_roll_link"), "{stdout}");
+    assert!(stdout.contains("joint limits:"), "{stdout}");
+    let npz = dir.join("walk.npz");
+    assert!(npz.is_file());
+    assert!(stdout.contains(&format!("wrote {}", npz.display())), "{stdout}");
+}
+
+#[test]
+fn output_format_from_extension_and_height_option() {
+    let dir = temp_dir("json");
+    let Some(bvh) = short_walk(&dir, 10) else { return };
+    let json = dir.join("out.json");
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        "unitree_h1",
+        "-o",
+        json.to_str().unwrap(),
+        "--human-height",
+        "1.75",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("subject height 1.750 m (given)"), "{stdout}");
+    let value: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(value.is_object());
+}
+
+#[test]
+fn mjcf_path_needs_a_config() {
+    let dir = temp_dir("path");
+    let Some(bvh) = short_walk(&dir, 5) else { return };
+    let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/unitree_g1/unitree_g1.xml");
+    let out = retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", xml.to_str().unwrap()]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("--config"), "{stderr}");
+    let config =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        xml.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "-o",
+        dir.join("o.npz").to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out).1);
+}
+
+#[test]
+fn bad_config_is_reported_with_its_position() {
+    let dir = temp_dir("badcfg");
+    let Some(bvh) = short_walk(&dir, 5) else { return };
+    let config = dir.join("bad.json");
+    std::fs::write(&config, "{\n  \"robot_root_name\": 3\n}\n").unwrap();
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        "unitree_g1",
+        "--config",
+        config.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains(&format!("{}:2:", config.display())), "{stderr}");
+}
+
+#[test]
+fn fps_is_not_supported_yet_and_unknown_robots_are_listed() {
+    let out = retarget(&["--bvh", "x.bvh", "--robot", "unitree_g1", "--fps", "50"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("not supported"));
+    let out = retarget(&["--bvh", "x.bvh", "--robot", "no_such_robot", "--config", "c.json"]);
+    assert_eq!(out.status.code(), Some(1));
+    let out = retarget(&["--bvh", "x.bvh"]);
+    assert_eq!(out.status.code(), Some(2));
+}
