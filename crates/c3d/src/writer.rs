@@ -191,7 +191,8 @@ impl C3d {
             params.set("ANALOG", "GEN_SCALE", Value::float(analog.gen_scale));
         }
         let last = self.first_frame.saturating_add(frames as u32).saturating_sub(1);
-        if frames > 65535 || params.get("TRIAL", "ACTUAL_START_FIELD").is_some() {
+        let header_frames_fit = frames <= 65535 && (1..=65535).contains(&self.first_frame);
+        if !header_frames_fit || params.get("TRIAL", "ACTUAL_START_FIELD").is_some() {
             let words =
                 |v: u32| Value::int16s(vec![(v & 0xffff) as u16 as i16, (v >> 16) as u16 as i16]);
             params.set("TRIAL", "ACTUAL_START_FIELD", words(self.first_frame));

@@ -325,3 +325,14 @@ fn more_than_255_points_and_channels_use_continuation_parameters() {
         assert_eq!(back.analog.get(3, 259), Some(4.5));
     }
 }
+
+#[test]
+fn first_frame_outside_the_header_range_goes_to_trial_fields() {
+    for first in [0, 70_000] {
+        let mut c = scratch();
+        c.first_frame = first;
+        let back = reread(&to_bytes(&c, Format::INTEL_FLOAT));
+        assert_eq!(back.first_frame, first);
+        assert_eq!(back.points, c.points);
+    }
+}
