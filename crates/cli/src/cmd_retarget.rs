@@ -129,13 +129,17 @@ fn print_summary(
     );
     let pos = diag.position_error_stats();
     let rot = diag.rotation_error_stats();
-    for (name, ((pm, p95), (rm, r95))) in diag.body_names.iter().zip(pos.iter().zip(&rot)) {
+    // Errors of an untracked quantity (weight 0 in every stage) are printed as "-".
+    let cell =
+        |on: bool, v: f64, unit: &str| if on { format!("{v:.1}{unit}") } else { "-".to_owned() };
+    for (k, name) in diag.body_names.iter().enumerate() {
+        let (p_on, r_on) = (diag.position_tracked[k], diag.rotation_tracked[k]);
         println!(
-            "{name:<28} {:>8.1}mm {:>8.1}mm {:>8.2}° {:>8.2}°",
-            pm * 1e3,
-            p95 * 1e3,
-            rm.to_degrees(),
-            r95.to_degrees()
+            "{name:<28} {:>10} {:>10} {:>10} {:>10}",
+            cell(p_on, pos[k].0 * 1e3, "mm"),
+            cell(p_on, pos[k].1 * 1e3, "mm"),
+            cell(r_on, rot[k].0.to_degrees(), "°"),
+            cell(r_on, rot[k].1.to_degrees(), "°")
         );
     }
     let (limit_frames, joint_frames) = diag.limit_hits();

@@ -61,6 +61,11 @@ pub struct RetargetOptions {
 pub struct ClipDiagnostics {
     /// Tracked robot bodies (same order as [`TrackedTargets::body_names`]).
     pub body_names: Vec<String>,
+    /// Per tracked body: whether some stage gives it a non-zero position weight (its
+    /// position error is meaningful) ...
+    pub position_tracked: Vec<bool>,
+    /// ... and a non-zero rotation weight.
+    pub rotation_tracked: Vec<bool>,
     pub frames: Vec<FrameDiagnostics>,
     /// Subject height used for scaling (m) and where it came from.
     pub human_height: f64,
@@ -142,6 +147,13 @@ pub fn retarget_motion(
     let tracked: Vec<(usize, usize)> = solver.tracked().to_vec();
 
     let (nb, nf, nq) = (human.num_bodies(), human.num_frames, model.nq);
+    if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
+        return Err(Error::InvalidOption(format!(
+            "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
+            human.positions.len(),
+            human.orientations.len()
+        )));
+    }
     let dt = if human.fps > 0.0 { 1.0 / human.fps } else { 0.0 };
     let mut poses =
         vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; map.bodies.len()];
@@ -190,8 +202,13 @@ pub fn retarget_motion(
             quat: target_quat,
         }),
     };
+    let weighted = |body: usize, pick: fn(&TaskSpec) -> f64| {
+        stages.iter().flatten().any(|t| t.body == body && pick(t) != 0.0)
+    };
     let diag = ClipDiagnostics {
         body_names: tracked_names,
+        position_tracked: tracked.iter().map(|&(b, _)| weighted(b, |t| t.pos_weight)).collect(),
+        rotation_tracked: tracked.iter().map(|&(b, _)| weighted(b, |t| t.rot_weight)).collect(),
         frames,
         human_height: height,
         human_height_source: "given".to_owned(),
