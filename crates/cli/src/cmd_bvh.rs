@@ -26,14 +26,20 @@ pub enum BvhCommand {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// World poses (m, Z up) of every body at one frame, plus units, subject height and ground.
+    Fk(crate::cmd_bvh_fk::FkArgs),
 }
 
 pub fn run(cmd: BvhCommand) -> anyhow::Result<ExitCode> {
     match cmd {
+        BvhCommand::Fk(args) => return crate::cmd_bvh_fk::run(&args),
         BvhCommand::Info { file } => {
             let bvh = bvh::from_path(&file)?;
             let summary = bvh::Summary::new(&bvh, &file.display().to_string());
             emit(None, |w| write!(w, "{summary}"))?;
+            for line in crate::cmd_bvh_fk::report_lines(&bvh)? {
+                println!("{line}");
+            }
         }
         BvhCommand::Json { file, output } => {
             let bvh = bvh::from_path(&file)?;

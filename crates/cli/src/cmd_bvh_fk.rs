@@ -181,6 +181,7 @@ impl FramePoses {
 
     /// World pose of a body by name.
     #[must_use]
+    #[cfg(test)]
     pub fn body(&self, name: &str) -> Option<&BodyPose> {
         self.bodies.iter().find(|b| b.name == name)
     }

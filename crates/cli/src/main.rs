@@ -3,13 +3,17 @@
 //! This file only wires subcommands; each family lives in its own module and owns its
 //! arguments. Exit codes: 0 success, 1 bad input or failed job, 2 usage error (clap).
 
-#[allow(dead_code)] // wired to `retarget batch` once the pipeline lands
 mod batch;
+mod cmd_batch;
 mod cmd_bvh;
+mod cmd_bvh_fk;
 mod cmd_c3d;
+mod cmd_report;
 mod cmd_retarget;
 mod cmd_robot;
+mod cmd_view;
 mod shipped;
+mod view;
 
 use std::process::ExitCode;
 
@@ -39,15 +43,25 @@ enum Command {
     /// Inspect one robot model (shipped name or MJCF path).
     #[command(subcommand)]
     Robot(cmd_robot::RobotCommand),
+    /// Convert a whole directory tree of clips, in parallel and resumable.
+    Batch(cmd_batch::BatchArgs),
+    /// Quality metrics of a retargeted motion (.npz): tracking, limits, jitter, foot contact.
+    Report(cmd_report::ReportArgs),
+    /// Write a self-contained HTML player (WebGL) with plots for a robot motion or a BVH.
+    View(cmd_view::ViewArgs),
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Bvh(cmd)) => cmd_bvh::run(cmd),
         Some(Command::C3d(cmd)) => cmd_c3d::run(cmd),
         Some(Command::Robots) => cmd_robot::list(),
         Some(Command::Robot(cmd)) => cmd_robot::run(cmd),
+        Some(Command::View(args)) => cmd_view::run(args),
+        Some(Command::Batch(args)) => cmd_batch::run(args),
+        Some(Command::Report(args)) => cmd_report::run(args),
         None => cmd_retarget::run_main(cli.main_job),
     };
     match result {
@@ -70,4 +84,15 @@ pub(crate) fn atomic_write(path: &std::path::Path, bytes: &[u8]) -> anyhow::Resu
         let _ = std::fs::remove_file(&tmp);
     }
     result.with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Rust ignores SIGPIPE, which turns `retarget … | head` into a panic in `println!`. A
+/// command-line tool should instead end quietly when its reader goes away, as C tools do.
+#[allow(unsafe_code)]
+fn restore_sigpipe() {
+    // SAFETY: called first thing in `main`, before any other thread exists; setting a signal
+    // disposition to the default has no other effect on Rust's runtime.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }

@@ -1,0 +1,178 @@
+//! `retarget batch IN_DIR --robot R -o OUT_DIR`: a whole tree of clips, in parallel, resumable.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use clap::Args;
+
+use retarget::writers::{write_motion, Format};
+use retarget::{IkConfig, RetargetOptions};
+
+use crate::batch::{self, ClipResult, Plan, Shard, Summary};
+
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// Directory tree of BVH files; relative paths are mirrored into the output directory.
+    #[arg(required_unless_present = "merge_summaries")]
+    pub input: Option<PathBuf>,
+    /// Robot: a shipped name (see `retarget robots`) or a path to an MJCF file (with --config).
+    #[arg(long, required_unless_present = "merge_summaries")]
+    pub robot: Option<String>,
+    /// Output directory (created if missing); with --merge-summaries, the merged JSON file.
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
+    /// IK config (GMR JSON schema); default: the shipped LAFAN1 config for the robot.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Output format of every clip.
+    #[arg(long, default_value = "npz", value_parser = ["npz", "csv", "pkl", "json"])]
+    pub format: String,
+    /// Clips converted at once (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Convert clips whose output already exists (default: skip them, which makes a killed
+    /// run resumable).
+    #[arg(long)]
+    pub overwrite: bool,
+    /// Process only shard K of N (0 <= K < N): the files whose index in the sorted file list
+    /// is K modulo N. For Slurm arrays: `--shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<Shard>,
+    /// Subject height in metres for every clip (default: estimated per clip from its skeleton).
+    #[arg(long)]
+    pub human_height: Option<f64>,
+    /// Merge shard summaries (summary-shard-K-of-N.json files) into one JSON file (-o).
+    #[arg(long, num_args = 1.., value_name = "SUMMARY", conflicts_with_all = ["input", "robot", "config", "shard"])]
+    pub merge_summaries: Vec<PathBuf>,
+}
+
+pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
+    let output = args.output.clone().context("--output is required")?;
+    if !args.merge_summaries.is_empty() {
+        return merge(&args.merge_summaries, &output);
+    }
+    let (Some(input), Some(robot)) = (args.input.clone(), args.robot.clone()) else {
+        bail!("batch needs IN_DIR and --robot");
+    };
+    if !input.is_dir() {
+        bail!("{}: not a directory", input.display());
+    }
+    let job = Job::load(&robot, args.config.as_deref(), args.human_height, &args.format)?;
+    let files = batch::select_shard(batch::walk(&input, &["bvh"])?, args.shard);
+    let jobs =
+        args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    eprintln!(
+        "batch: {} clips{} from {} onto {robot}, {jobs} at a time",
+        files.len(),
+        args.shard.map(|s| format!(" (shard {s})")).unwrap_or_default(),
+        input.display()
+    );
+    let plan = Plan {
+        input_dir: &input,
+        output_dir: &output,
+        files,
+        extension: &args.format,
+        overwrite: args.overwrite,
+        jobs,
+        robot: &robot,
+        shard: args.shard,
+    };
+    let summary = batch::run(&plan, |src: &Path, dst: &Path| {
+        let (frames, metrics) = job.convert_file(src, dst)?;
+        Ok(ClipResult { frames, metrics })
+    })?;
+    print_table(&summary);
+    eprintln!("batch: summary in {}", output.join(Summary::file_name(args.shard)).display());
+    Ok(if summary.totals.failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn merge(parts: &[PathBuf], output: &Path) -> anyhow::Result<ExitCode> {
+    let summaries = parts
+        .iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("{}: cannot read", p.display()))?;
+            serde_json::from_str::<Summary>(&text)
+                .with_context(|| format!("{}: not a batch summary", p.display()))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let merged = Summary::merge(&summaries)?;
+    crate::atomic_write(output, (serde_json::to_string_pretty(&merged)? + "\n").as_bytes())?;
+    print_table(&merged);
+    Ok(if merged.totals.failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn print_table(summary: &Summary) {
+    let t = &summary.totals;
+    let rate = t.frames as f64 / t.seconds.max(1e-9);
+    println!(
+        "clips {}  converted {}  skipped {}  failed {}  frames {}  wall {:.1} s  {rate:.0} frames/s",
+        t.clips, t.converted, t.skipped, t.failed, t.frames, t.seconds
+    );
+    for clip in summary.clips.iter().filter(|c| c.status == "failed") {
+        println!("  failed  {}: {}", clip.input, clip.error.as_deref().unwrap_or("?"));
+    }
+}
+
+/// What every clip of a batch shares: the robot, its config and the options.
+struct Job {
+    model: mjcf::Model,
+    config: IkConfig,
+    options: RetargetOptions,
+    format: Format,
+}
+
+impl Job {
+    fn load(
+        robot: &str,
+        config: Option<&Path>,
+        human_height: Option<f64>,
+        format: &str,
+    ) -> anyhow::Result<Job> {
+        let config = match (config, crate::cmd_retarget::shipped_config(robot)) {
+            (Some(path), _) => IkConfig::from_file(path)?,
+            (None, Some(config)) => config?,
+            (None, None) => {
+                bail!("--robot {robot} is not a shipped robot: give its IK config with --config")
+            }
+        };
+        let format = Format::from_path(Path::new(&format!("x.{format}")))
+            .with_context(|| format!("--format {format}: expected npz, csv, pkl or json"))?;
+        Ok(Job {
+            model: crate::shipped::robot_model(robot)?,
+            config,
+            options: RetargetOptions { human_height, ..RetargetOptions::default() },
+            format,
+        })
+    }
+
+    /// Retarget one file and write it; returns the frame count and the quality metrics.
+    fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<(usize, serde_json::Value)> {
+        remove_stale_temporaries(dst);
+        let bvh = bvh::from_path(src)?;
+        let (motion, _diag) =
+            retarget::retarget_bvh(&bvh, &self.model, &self.config, &self.options)
+                .with_context(|| format!("{}: retargeting", src.display()))?;
+        let quality = retarget::report::report(
+            &motion,
+            &self.model,
+            &retarget::report::ReportOptions::default(),
+        )?;
+        write_motion(dst, &motion, &self.model, Some(self.format))?;
+        Ok((motion.num_frames(), serde_json::to_value(&quality)?))
+    }
+}
+
+/// A run killed while writing `dst` leaves `.<name>.tmp-*` beside it (the writers rename a
+/// temporary file into place); the clip is about to be rewritten, so they can go.
+fn remove_stale_temporaries(dst: &Path) {
+    let (Some(dir), Some(name)) = (dst.parent(), dst.file_name()) else { return };
+    let prefix = format!(".{}.tmp-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(&prefix) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}

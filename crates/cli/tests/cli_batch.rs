@@ -1,0 +1,203 @@
+//! `retarget batch` end to end: a small tree of real clips, failure isolation, resume after
+//! SIGKILL at several points, byte-identical outputs, shards and merged summaries.
+
+#[path = "../../../tests/support/shared.rs"]
+mod shared;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+const BIN: &str = env!("CARGO_BIN_EXE_retarget");
+
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        let p =
+            std::env::temp_dir().join(format!("retarget-cli-batch-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).unwrap();
+        TempDir(p)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A BVH with the source's hierarchy and `count` frames starting at `start`.
+fn excerpt(source: &str, start: usize, count: usize) -> String {
+    let (head, motion) = source.split_once("MOTION").expect("a MOTION block");
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let _frames = lines.next();
+    let frame_time = lines.next().expect("Frame Time line");
+    let rows: Vec<&str> = lines.skip(start).take(count).collect();
+    assert_eq!(rows.len(), count, "source too short for the excerpt");
+    format!("{head}MOTION\nFrames: {count}\n{}\n{}\n", frame_time.trim(), rows.join("\n"))
+}
+
+/// Five excerpts of the LAFAN1 walk in nested folders, plus one malformed clip.
+fn make_tree(root: &Path, source: &str) {
+    for (i, rel) in
+        ["a/walk0.bvh", "a/walk1.bvh", "b/c/walk2.bvh", "walk3.bvh", "walk4.bvh"].iter().enumerate()
+    {
+        let path = root.join(rel);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, excerpt(source, 600 * i, 240)).unwrap();
+    }
+    std::fs::write(root.join("a/broken.bvh"), "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n").unwrap();
+}
+
+fn batch(args: &[&str]) -> Command {
+    let mut cmd = Command::new(BIN);
+    cmd.arg("batch").args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
+    cmd
+}
+
+/// Every regular file under `root`, relative, sorted, with its bytes.
+fn files(root: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                let rel = path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+                out.push((rel, std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn outputs(root: &Path) -> Vec<(String, Vec<u8>)> {
+    files(root).into_iter().filter(|(name, _)| !name.starts_with("summary")).collect()
+}
+
+#[test]
+fn batch_isolates_failures_and_resumes_after_kills_with_identical_outputs() {
+    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let source = std::fs::read_to_string(walk).unwrap();
+    let tmp = TempDir::new("kill");
+    let tree = tmp.0.join("tree");
+    make_tree(&tree, &source);
+    let tree_s = tree.to_str().unwrap();
+
+    // Uninterrupted reference run.
+    let reference = tmp.0.join("ref");
+    let done =
+        batch(&[tree_s, "--robot", "unitree_g1", "-o", reference.to_str().unwrap(), "--jobs", "2"])
+            .output()
+            .unwrap();
+    let stdout = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(1), "a failed clip makes the exit code 1: {stdout}");
+    assert!(stdout.contains("converted 5") && stdout.contains("failed 1"), "{stdout}");
+    assert!(stdout.contains("a/broken.bvh"), "the failed clip is named: {stdout}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(reference.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["totals"]["converted"], 5);
+    assert_eq!(summary["totals"]["frames"], 5 * 240);
+    let want = outputs(&reference);
+    assert_eq!(want.len(), 5, "{:?}", want.iter().map(|f| &f.0).collect::<Vec<_>>());
+
+    // Kill at several points (fixed pseudo-random delays), then finish the rest.
+    let resumed = tmp.0.join("resumed");
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    for _ in 0..4 {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        let delay = Duration::from_millis(20 + seed % 400);
+        let mut child = batch(&[
+            tree_s,
+            "--robot",
+            "unitree_g1",
+            "-o",
+            resumed.to_str().unwrap(),
+            "--jobs",
+            "2",
+        ])
+        .spawn()
+        .unwrap();
+        std::thread::sleep(delay);
+        let _ = child.kill(); // SIGKILL: no chance to clean up
+        let _ = child.wait();
+        // Whatever exists under a final name is complete: it equals the reference.
+        for (name, bytes) in outputs(&resumed)
+            .iter()
+            .filter(|(n, _)| !n.rsplit('/').next().unwrap().starts_with('.'))
+        {
+            let reference_bytes = &want
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap_or_else(|| panic!("unexpected output {name}"))
+                .1;
+            assert!(bytes == reference_bytes, "{name} is torn after a kill at {delay:?}");
+        }
+    }
+    let finish =
+        batch(&[tree_s, "--robot", "unitree_g1", "-o", resumed.to_str().unwrap(), "--jobs", "2"])
+            .output()
+            .unwrap();
+    assert_eq!(finish.status.code(), Some(1));
+    let got: Vec<_> = outputs(&resumed)
+        .into_iter()
+        .filter(|(n, _)| !n.rsplit('/').next().unwrap().starts_with('.'))
+        .collect();
+    assert_eq!(got.len(), want.len());
+    for ((gn, gb), (wn, wb)) in got.iter().zip(&want) {
+        assert_eq!(gn, wn);
+        assert!(gb == wb, "{gn} differs from the uninterrupted run");
+    }
+}
+
+#[test]
+fn shards_cover_the_tree_and_merge() {
+    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let source = std::fs::read_to_string(walk).unwrap();
+    let tmp = TempDir::new("shard");
+    let tree = tmp.0.join("tree");
+    make_tree(&tree, &source);
+    let out = tmp.0.join("out");
+    let mut parts = Vec::new();
+    for k in 0..2 {
+        let shard = format!("{k}/2");
+        let done = batch(&[
+            tree.to_str().unwrap(),
+            "--robot",
+            "unitree_g1",
+            "-o",
+            out.to_str().unwrap(),
+            "--shard",
+            &shard,
+            "--jobs",
+            "1",
+        ])
+        .output()
+        .unwrap();
+        assert!(done.status.code().is_some());
+        parts.push(out.join(format!("summary-shard-{k}-of-2.json")));
+    }
+    let merged = tmp.0.join("merged.json");
+    let mut args = vec!["--merge-summaries".to_string()];
+    args.extend(parts.iter().map(|p| p.to_string_lossy().into_owned()));
+    args.extend(["-o".to_string(), merged.to_string_lossy().into_owned()]);
+    let done = Command::new(BIN).arg("batch").args(&args).output().unwrap();
+    assert_eq!(done.status.code(), Some(1), "the merged summary still has the failed clip");
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(merged).unwrap()).unwrap();
+    assert_eq!(m["totals"]["clips"], 6);
+    assert_eq!(m["totals"]["converted"], 5);
+    assert_eq!(m["shards"].as_array().unwrap().len(), 2);
+}
