@@ -1,6 +1,5 @@
 //! `retarget bvh …`: inspect, export and rewrite BVH files.
 
-use std::fs::File;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -60,7 +59,7 @@ fn emit(
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> anyhow::Result<()> {
     match output {
-        Some(path) => write_atomically(path, write),
+        Some(path) => crate::atomic_write_with(path, write),
         None => {
             let mut stdout = io::stdout().lock();
             match write(&mut stdout).and_then(|()| stdout.flush()) {
@@ -69,25 +68,4 @@ fn emit(
             }
         }
     }
-}
-
-/// Write `OUT.tmp-<pid>` beside `path`, then rename it over `path`: an interrupted or failed
-/// run leaves no half-written output.
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
-) -> anyhow::Result<()> {
-    let name = path.file_name().with_context(|| format!("{}: not a file name", path.display()))?;
-    let mut tmp_name = name.to_os_string();
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = File::create(&tmp).and_then(|mut file| {
-        write(&mut file)?;
-        file.sync_all()
-    });
-    let result = result.and_then(|()| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("{}: cannot write", path.display()))
 }

@@ -73,13 +73,28 @@ fn main() -> ExitCode {
     }
 }
 
-/// Write `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// that an interrupted run never leaves a half-written file under the final name.
+/// Write `bytes` to `path` atomically (see [`atomic_write_with`]).
 pub(crate) fn atomic_write(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    atomic_write_with(path, |w| w.write_all(bytes))
+}
+
+/// Fill `.<name>.tmp-<pid>` beside `path` through `write`, sync it, then rename it over
+/// `path`: an interrupted or failed run never leaves a half-written file under the final
+/// name, and a failed one removes its temporary file.
+pub(crate) fn atomic_write_with(
+    path: &std::path::Path,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
+) -> anyhow::Result<()> {
     use anyhow::Context;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    let name = path.file_name().with_context(|| format!("{}: not a file name", path.display()))?;
+    let tmp =
+        path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    let result = std::fs::File::create(&tmp)
+        .and_then(|mut file| {
+            write(&mut file)?;
+            file.sync_all()
+        })
+        .and_then(|()| std::fs::rename(&tmp, path));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
