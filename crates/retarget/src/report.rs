@@ -220,6 +220,10 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
     {
         return Ok([l, r]);
     }
+    // The robots in `robots/` mark their soles with geoms named `left_sole` / `right_sole`.
+    if let (Some(l), Some(r)) = (model.geom_id("left_sole"), model.geom_id("right_sole")) {
+        return Ok([model.geoms[l].body, model.geoms[r].body]);
+    }
     let mut data = mjcf::Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
     let side = |markers: [&str; 3], prefix: &str| {

@@ -237,3 +237,28 @@ fn unknown_foot_names_are_errors() {
     let err = report(&motion, &model, &opts).unwrap_err().to_string();
     assert!(err.contains("left_foot"), "{err}");
 }
+
+/// Every shipped robot has two feet found automatically, the left one on the robot's left
+/// (+y in the MJCF frame at qpos0, where every model faces +x).
+#[test]
+fn every_shipped_robot_has_its_feet_detected_on_the_right_sides() {
+    let robots = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&robots).unwrap() {
+        let dir = entry.unwrap().path();
+        let Some(key) = dir.file_name().and_then(|n| n.to_str()).map(str::to_owned) else {
+            continue;
+        };
+        let xml = dir.join(format!("{key}.xml"));
+        if !xml.is_file() {
+            continue;
+        }
+        let model = mjcf::Model::from_file(&xml).unwrap();
+        let [l, r] = detect_feet(&model).unwrap_or_else(|e| panic!("{key}: {e}"));
+        let mut data = mjcf::Data::new(&model);
+        model.kinematics(&model.qpos0, &mut data);
+        assert!(data.xpos[l].y > data.xpos[r].y, "{key}: left foot is not on the left");
+        checked += 1;
+    }
+    assert!(checked >= 6, "only {checked} robots found");
+}
