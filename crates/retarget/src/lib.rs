@@ -7,6 +7,7 @@ pub mod motion;
 pub mod pipeline;
 pub mod qp;
 pub mod report;
+pub mod resample;
 pub mod solver;
 pub mod targets;
 pub mod writers;
