@@ -201,3 +201,33 @@ fn shards_cover_the_tree_and_merge() {
     assert_eq!(m["totals"]["converted"], 5);
     assert_eq!(m["shards"].as_array().unwrap().len(), 2);
 }
+
+#[test]
+fn long_clips_can_be_split_into_parallel_chunks() {
+    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let source = std::fs::read_to_string(walk).unwrap();
+    let tmp = TempDir::new("chunk");
+    let tree = tmp.0.join("tree");
+    make_tree(&tree, &source);
+    let out = tmp.0.join("out");
+    let done = batch(&[
+        tree.to_str().unwrap(),
+        "--robot",
+        "unitree_g1",
+        "-o",
+        out.to_str().unwrap(),
+        "--chunk-frames",
+        "100",
+        "--lead-in",
+        "30",
+    ])
+    .output()
+    .unwrap();
+    assert_eq!(done.status.code(), Some(1), "{}", String::from_utf8_lossy(&done.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["totals"]["converted"], 5);
+    assert_eq!(summary["totals"]["frames"], 5 * 240, "chunks keep every frame once");
+}

@@ -1,6 +1,7 @@
 //! Retargeting: GMR-schema IK configs, per-frame targets, the damped-least-squares solver,
 //! the resulting robot motion, its writers and quality metrics.
 
+pub mod chunked;
 pub mod config;
 pub mod lie;
 pub mod motion;

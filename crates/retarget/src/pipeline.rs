@@ -54,6 +54,8 @@ pub struct RetargetOptions {
     pub human_height: Option<f64>,
     pub solver: SolverOptions,
     pub fk: FkOptions,
+    /// Solve long clips as parallel chunks ([`crate::chunked`]); `None`: one serial pass.
+    pub chunk: Option<crate::chunked::ChunkOptions>,
 }
 
 /// Per-clip diagnostics: per frame, and which bodies the per-body arrays refer to.
@@ -124,7 +126,12 @@ pub fn retarget_bvh(
     let (human, report) = fk::human_motion(bvh, &fk_options)?;
     let mut opts = options.clone();
     opts.human_height = Some(report.height);
-    let (motion, mut diag) = retarget_motion(&human, model, config, &opts)?;
+    let (motion, mut diag) = match options.chunk {
+        Some(chunk) => {
+            crate::chunked::retarget_motion_chunked(&human, model, config, &opts, chunk)?
+        }
+        None => retarget_motion(&human, model, config, &opts)?,
+    };
     diag.human_height_source = report.height_source;
     Ok((motion, diag))
 }
