@@ -1,4 +1,5 @@
-//! The main job: `retarget --bvh FILE --robot NAME [-o OUT] [--config C] [--human-height H]`.
+//! The main job: `retarget --bvh FILE --robot NAME [-o OUT] [--config C] [--human-height H]`,
+//! or `retarget --c3d FILE --config MARKER_CONFIG --robot NAME ...` (marker-driven).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -10,12 +11,17 @@ use retarget::writers::{write_motion, Format};
 use retarget::{ClipDiagnostics, IkConfig, RetargetOptions, RobotMotion};
 
 use crate::shipped;
+use fk::markers::MarkerBody;
 
 #[derive(Args, Debug)]
 pub struct MainArgs {
     /// BVH motion capture file to retarget.
     #[arg(long)]
     pub bvh: Option<PathBuf>,
+    /// C3D marker file to retarget (instead of --bvh); needs a marker config (--config)
+    /// with `marker_bodies`, e.g. configs/c3d_plugingait_to_unitree_g1.json.
+    #[arg(long, value_name = "FILE", conflicts_with = "bvh", requires = "config")]
+    pub c3d: Option<PathBuf>,
     /// Robot: a shipped name (see `retarget robots`) or a path to an MJCF file.
     #[arg(long)]
     pub robot: Option<String>,
@@ -56,15 +62,18 @@ pub fn shipped_config(key: &str) -> Option<anyhow::Result<IkConfig>> {
 }
 
 pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
-    let (Some(bvh_path), Some(robot)) = (args.bvh.clone(), args.robot.clone()) else {
-        eprintln!("usage: retarget --bvh FILE --robot NAME [-o OUT]   (see `retarget --help`)");
+    let input = args.bvh.clone().or_else(|| args.c3d.clone());
+    let (Some(input), Some(robot)) = (input, args.robot.clone()) else {
+        eprintln!(
+            "usage: retarget --bvh FILE | --c3d FILE --config C --robot NAME [-o OUT]   (see `retarget --help`)"
+        );
         return Ok(ExitCode::from(2));
     };
     if args.fps.is_some() {
         bail!("--fps: resampling is not supported yet; the output keeps the source frame rate");
     }
     let format = parse_format(args.format.as_deref())?;
-    let output = output_path(&bvh_path, args.output.as_deref(), format);
+    let output = output_path(&input, args.output.as_deref(), format);
     let config = match (&args.config, shipped_config(&robot)) {
         (Some(path), _) => IkConfig::from_file(path)?,
         (None, Some(config)) => config?,
@@ -74,14 +83,154 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     };
     let model = shipped::robot_model(&robot)?;
     let started = Instant::now();
-    let bvh = bvh::from_path(&bvh_path).with_context(|| format!("{}", bvh_path.display()))?;
     let options = RetargetOptions { human_height: args.human_height, ..RetargetOptions::default() };
-    let (motion, diag) = retarget::retarget_bvh(&bvh, &model, &config, &options)
-        .with_context(|| format!("{}: retargeting onto {robot}", bvh_path.display()))?;
+    let (motion, diag) = if args.c3d.is_some() {
+        let config_path = args.config.as_deref().context("--c3d needs --config")?;
+        let markers = MarkerConfig::from_file(config_path)?;
+        let (human, height, source) = c3d_human_motion(&input, &markers, args.human_height)?;
+        let opts = RetargetOptions { human_height: Some(height), ..options };
+        let (motion, mut diag) = retarget::retarget_motion(&human, &model, &config, &opts)
+            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?;
+        diag.human_height_source = source;
+        (motion, diag)
+    } else {
+        let bvh = bvh::from_path(&input).with_context(|| format!("{}", input.display()))?;
+        retarget::retarget_bvh(&bvh, &model, &config, &options)
+            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
+    };
     write_motion(&output, &motion, &model, format)?;
     let wall = started.elapsed().as_secs_f64();
-    print_summary(&bvh_path, &output, &motion, &diag, wall);
+    print_summary(&input, &output, &motion, &diag, wall);
     Ok(ExitCode::SUCCESS)
+}
+
+/// The marker part of a marker-driven IK config (keys the IK config itself ignores).
+struct MarkerConfig {
+    bodies: Vec<MarkerBody>,
+    /// `source_axes`, checked.
+    axes: String,
+    metres_per_unit: f64,
+    /// Landmarks for the subject height: top markers, bottom markers, and the fraction of
+    /// the stature the top markers stand at.
+    height: Option<(Vec<String>, Vec<String>, f64)>,
+    /// `subject_height_m`, when the config fixes it.
+    subject_height: Option<f64>,
+}
+
+impl MarkerConfig {
+    fn from_file(path: &Path) -> anyhow::Result<MarkerConfig> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+        let json: serde_json::Value =
+            serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
+        let at = |key: &str| format!("{}: `{key}`", path.display());
+        let strings = |v: &serde_json::Value, key: &str| -> anyhow::Result<Vec<String>> {
+            v.as_array()
+                .with_context(|| format!("{}: expected a list of marker labels", at(key)))?
+                .iter()
+                .map(|m| m.as_str().map(str::to_owned).with_context(|| at(key)))
+                .collect()
+        };
+        let table = json.get("marker_bodies").and_then(serde_json::Value::as_object).with_context(
+            || format!("{}: a marker config needs `marker_bodies`", path.display()),
+        )?;
+        let mut bodies = Vec::new();
+        for (name, def) in table {
+            let markers =
+                strings(def.get("markers").with_context(|| at(&format!("{name}.markers")))?, name)?;
+            let frame = match def.get("frame") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(v) => {
+                    let f = strings(v, &format!("{name}.frame"))?;
+                    let [a, b, c]: [String; 3] = f.try_into().map_err(|_| {
+                        anyhow::anyhow!(
+                            "{}: needs exactly three markers",
+                            at(&format!("{name}.frame"))
+                        )
+                    })?;
+                    Some([a, b, c])
+                }
+            };
+            bodies.push(MarkerBody { name: name.clone(), markers, frame });
+        }
+        let axes_name =
+            json.get("source_axes").and_then(serde_json::Value::as_str).unwrap_or("z-up");
+        if fk::markers::axes_rotation(axes_name).is_none() {
+            bail!("{}: `{axes_name}`: expected \"z-up\" or \"y-up\"", at("source_axes"));
+        }
+        let axes = axes_name.to_owned();
+        let metres_per_unit =
+            json.get("marker_units_m").and_then(serde_json::Value::as_f64).unwrap_or(0.001);
+        let height = match json.get("marker_height") {
+            None => None,
+            Some(h) => Some((
+                strings(
+                    h.get("top").with_context(|| at("marker_height.top"))?,
+                    "marker_height.top",
+                )?,
+                strings(
+                    h.get("bottom").with_context(|| at("marker_height.bottom"))?,
+                    "marker_height.bottom",
+                )?,
+                h.get("fraction_of_stature")
+                    .and_then(serde_json::Value::as_f64)
+                    .with_context(|| at("marker_height.fraction_of_stature"))?,
+            )),
+        };
+        let subject_height = json.get("subject_height_m").and_then(serde_json::Value::as_f64);
+        Ok(MarkerConfig { bodies, axes, metres_per_unit, height, subject_height })
+    }
+}
+
+/// Reads a C3D file and builds the virtual marker bodies; returns them with the subject
+/// height and where it came from.
+fn c3d_human_motion(
+    path: &Path,
+    markers: &MarkerConfig,
+    human_height: Option<f64>,
+) -> anyhow::Result<(fk::HumanMotion, f64, String)> {
+    let file = c3d::C3d::from_path(path).with_context(|| format!("{}", path.display()))?;
+    let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();
+    let frames: Vec<Vec<Option<[f64; 3]>>> = (0..file.points.frame_count())
+        .map(|f| {
+            (0..labels.len())
+                .map(|p| file.points.get(f, p).map(|pt| pt.position.map(f64::from)))
+                .collect()
+        })
+        .collect();
+    let fps = f64::from(file.point_rate());
+    let axes = fk::markers::axes_rotation(&markers.axes).context("source_axes")?;
+    let human = fk::markers::marker_motion(
+        &labels,
+        &frames,
+        fps,
+        markers.metres_per_unit,
+        &axes,
+        &markers.bodies,
+    )
+    .with_context(|| format!("{}: marker bodies", path.display()))?;
+    let (height, source) = if let Some(h) = human_height {
+        (h, "given".to_owned())
+    } else if let Some(h) = markers.subject_height {
+        (h, "config subject_height_m".to_owned())
+    } else if let Some((top, bottom, fraction)) = &markers.height {
+        let above = fk::markers::marker_height(
+            &labels,
+            &frames,
+            markers.metres_per_unit,
+            &axes,
+            top,
+            bottom,
+        )
+        .with_context(|| format!("{}: subject height", path.display()))?
+        .with_context(|| format!("{}: height markers never seen", path.display()))?;
+        (above / fraction, format!("markers {} at {fraction} of stature", top.join("+")))
+    } else {
+        bail!("{}: give --human-height (the config has no `marker_height`)", path.display())
+    };
+    if !(height.is_finite() && height > 0.0) {
+        bail!("{}: subject height {height} m is not positive", path.display());
+    }
+    Ok((human, height, source))
 }
 
 fn parse_format(text: Option<&str>) -> anyhow::Result<Option<Format>> {

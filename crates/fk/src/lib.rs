@@ -26,6 +26,7 @@
 
 mod error;
 mod forward;
+pub mod markers;
 mod math;
 mod motion;
 mod options;

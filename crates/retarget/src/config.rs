@@ -80,6 +80,19 @@ struct RawConfig {
     #[serde(default)]
     #[allow(dead_code)]
     robot_initial_qpos: Option<serde_json::Value>,
+    /// Marker-driven configs (`retarget --c3d`): read by the CLI, ignored here.
+    #[serde(default)]
+    #[allow(dead_code)]
+    marker_bodies: Option<serde_json::Value>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    source_axes: Option<serde_json::Value>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    marker_units_m: Option<serde_json::Value>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    marker_height: Option<serde_json::Value>,
 }
 
 type RawEntry = (String, f64, f64, [f64; 3], [f64; 4]);
