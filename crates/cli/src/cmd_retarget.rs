@@ -36,7 +36,8 @@ pub struct MainArgs {
     /// Subject height in metres (default: estimated from the skeleton; GMR assumes 1.75).
     #[arg(long, value_name = "METRES")]
     pub human_height: Option<f64>,
-    /// Output frame rate (resampling; not supported yet).
+    /// Output frame rate: the solved motion is resampled (linear for positions and angles,
+    /// slerp for the root and ball joints). Default: the source's rate.
     #[arg(long, value_name = "HZ")]
     pub fps: Option<f64>,
     /// Output format, overriding the extension: npz, csv, pkl or json.
@@ -69,9 +70,6 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::from(2));
     };
-    if args.fps.is_some() {
-        bail!("--fps: resampling is not supported yet; the output keeps the source frame rate");
-    }
     let format = parse_format(args.format.as_deref())?;
     let output = output_path(&input, args.output.as_deref(), format);
     let config = match (&args.config, shipped_config(&robot)) {
@@ -98,7 +96,19 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         retarget::retarget_bvh(&bvh, &model, &config, &options)
             .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
     };
-    write_motion(&output, &motion, &model, format)?;
+    match args.fps {
+        Some(fps) => {
+            let resampled = retarget::resample::resample(&motion, &model, fps)?;
+            write_motion(&output, &resampled, &model, format)?;
+            println!(
+                "resampled {} frames at {} fps to {} frames at {fps} fps",
+                motion.num_frames(),
+                motion.fps,
+                resampled.num_frames()
+            );
+        }
+        None => write_motion(&output, &motion, &model, format)?,
+    }
     let wall = started.elapsed().as_secs_f64();
     print_summary(&input, &output, &motion, &diag, wall);
     Ok(ExitCode::SUCCESS)

@@ -123,10 +123,20 @@ fn bad_config_is_reported_with_its_position() {
 }
 
 #[test]
-fn fps_is_not_supported_yet_and_unknown_robots_are_listed() {
-    let out = retarget(&["--bvh", "x.bvh", "--robot", "unitree_g1", "--fps", "50"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out).1.contains("not supported"));
+fn fps_resamples_the_output_and_unknown_robots_are_errors() {
+    let dir = temp_dir("fps");
+    if let Some(bvh) = short_walk(&dir, 31) {
+        let csv = dir.join("walk60.csv");
+        let args = ["--bvh", bvh.to_str().unwrap(), "--robot", "unitree_g1", "--fps", "60"];
+        let out = retarget(&[&args[..], &["-o", csv.to_str().unwrap()]].concat());
+        assert!(out.status.success(), "{}", text(&out).1);
+        // 31 frames at 30 fps span 1 s: 61 frames at 60 fps.
+        let rows = std::fs::read_to_string(&csv).unwrap().lines().count();
+        assert_eq!(rows, 61);
+        let bad = retarget(&[&args[..4], &["--fps", "0", "-o", csv.to_str().unwrap()]].concat());
+        assert_eq!(bad.status.code(), Some(1));
+        assert!(text(&bad).1.contains("--fps"), "{}", text(&bad).1);
+    }
     let out = retarget(&["--bvh", "x.bvh", "--robot", "no_such_robot", "--config", "c.json"]);
     assert_eq!(out.status.code(), Some(1));
     let out = retarget(&["--bvh", "x.bvh"]);
