@@ -78,27 +78,15 @@ pub(crate) fn atomic_write(path: &std::path::Path, bytes: &[u8]) -> anyhow::Resu
     atomic_write_with(path, |w| w.write_all(bytes))
 }
 
-/// Fill `.<name>.tmp-<pid>` beside `path` through `write`, sync it, then rename it over
-/// `path`: an interrupted or failed run never leaves a half-written file under the final
-/// name, and a failed one removes its temporary file.
+/// Fill a temporary file beside `path` through `write`, then rename it into place
+/// ([`retarget::writers::write_atomically`]): an interrupted or failed run never leaves a
+/// half-written file under the final name.
 pub(crate) fn atomic_write_with(
     path: &std::path::Path,
     write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> anyhow::Result<()> {
-    use anyhow::Context;
-    let name = path.file_name().with_context(|| format!("{}: not a file name", path.display()))?;
-    let tmp =
-        path.with_file_name(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut file| {
-            write(&mut file)?;
-            file.sync_all()
-        })
-        .and_then(|()| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.with_context(|| format!("{}: cannot write", path.display()))
+    retarget::writers::write_atomically(path, |w| write(w))
+        .map_err(|e| anyhow::anyhow!("cannot write {e}"))
 }
 
 /// Rust ignores SIGPIPE, which turns `retarget … | head` into a panic in `println!`. A

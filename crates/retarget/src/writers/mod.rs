@@ -202,8 +202,9 @@ pub(crate) fn root_pose(
 static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
 
 /// Writes through `fill` into `.<name>.tmp-<pid>-<n>` next to `path`, syncs, renames it to
-/// `path`; removes the temporary file on any error.
-fn write_atomically<F>(path: &Path, fill: F) -> Result<(), Error>
+/// `path`; removes the temporary file on any error. Every output of the project goes through
+/// this one function (the CLI's too), so a killed run leaves only `.<name>.tmp-*` files.
+pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 {
