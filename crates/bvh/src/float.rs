@@ -42,18 +42,7 @@ pub(crate) fn parse_number(src: &[u8], start: usize) -> Option<(f64, usize)> {
 /// slow path", never "invalid".
 #[inline]
 fn fast_path(src: &[u8], start: usize) -> Option<(f64, usize)> {
-    let mut i = start;
-    let negative = match src.get(i) {
-        Some(b'-') => {
-            i += 1;
-            true
-        }
-        Some(b'+') => {
-            i += 1;
-            false
-        }
-        _ => false,
-    };
+    let (negative, mut i) = sign(src, start);
     let mut mantissa: u64 = 0;
     let mut digits = 0u32;
     let mut exponent: i64 = 0;
@@ -97,20 +86,20 @@ fn fast_path(src: &[u8], start: usize) -> Option<(f64, usize)> {
     Some((if negative { -value } else { value }, i))
 }
 
+/// An optional `+` or `-` at `i`: whether it was `-`, and the index after it.
+#[inline]
+fn sign(src: &[u8], i: usize) -> (bool, usize) {
+    match src.get(i) {
+        Some(b'-') => (true, i + 1),
+        Some(b'+') => (false, i + 1),
+        _ => (false, i),
+    }
+}
+
 /// `[+-]digits` after an `e`; saturates far outside the fast path's range.
 #[inline]
-fn exponent_part(src: &[u8], mut i: usize) -> Option<(i64, usize)> {
-    let negative = match src.get(i) {
-        Some(b'-') => {
-            i += 1;
-            true
-        }
-        Some(b'+') => {
-            i += 1;
-            false
-        }
-        _ => false,
-    };
+fn exponent_part(src: &[u8], i: usize) -> Option<(i64, usize)> {
+    let (negative, mut i) = sign(src, i);
     let first = i;
     let mut e: i64 = 0;
     while let Some(&b) = src.get(i) {
