@@ -51,6 +51,16 @@ fn make_tree(root: &Path, source: &str) {
     std::fs::write(root.join("a/broken.bvh"), "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n").unwrap();
 }
 
+/// A temporary folder holding `tree/` (see [`make_tree`]); `None` without reference data.
+fn tree_of_clips(tag: &str) -> Option<(TempDir, PathBuf)> {
+    let walk = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh")?;
+    let source = std::fs::read_to_string(walk).unwrap();
+    let tmp = TempDir::new(tag);
+    let tree = tmp.0.join("tree");
+    make_tree(&tree, &source);
+    Some((tmp, tree))
+}
+
 fn batch(args: &[&str]) -> Command {
     let mut cmd = Command::new(BIN);
     cmd.arg("batch").args(args).stdout(Stdio::piped()).stderr(Stdio::piped());
@@ -82,13 +92,7 @@ fn outputs(root: &Path) -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn batch_isolates_failures_and_resumes_after_kills_with_identical_outputs() {
-    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
-        return;
-    };
-    let source = std::fs::read_to_string(walk).unwrap();
-    let tmp = TempDir::new("kill");
-    let tree = tmp.0.join("tree");
-    make_tree(&tree, &source);
+    let Some((tmp, tree)) = tree_of_clips("kill") else { return };
     let tree_s = tree.to_str().unwrap();
 
     // Uninterrupted reference run.
@@ -162,13 +166,7 @@ fn batch_isolates_failures_and_resumes_after_kills_with_identical_outputs() {
 
 #[test]
 fn shards_cover_the_tree_and_merge() {
-    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
-        return;
-    };
-    let source = std::fs::read_to_string(walk).unwrap();
-    let tmp = TempDir::new("shard");
-    let tree = tmp.0.join("tree");
-    make_tree(&tree, &source);
+    let Some((tmp, tree)) = tree_of_clips("shard") else { return };
     let out = tmp.0.join("out");
     let mut parts = Vec::new();
     for k in 0..2 {
@@ -204,13 +202,7 @@ fn shards_cover_the_tree_and_merge() {
 
 #[test]
 fn long_clips_can_be_split_into_parallel_chunks() {
-    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
-        return;
-    };
-    let source = std::fs::read_to_string(walk).unwrap();
-    let tmp = TempDir::new("chunk");
-    let tree = tmp.0.join("tree");
-    make_tree(&tree, &source);
+    let Some((tmp, tree)) = tree_of_clips("chunk") else { return };
     let out = tmp.0.join("out");
     let done = batch(&[
         tree.to_str().unwrap(),
