@@ -140,15 +140,9 @@ impl Job {
         human_height: Option<f64>,
         format: &str,
     ) -> anyhow::Result<Job> {
-        let config = match (config, crate::cmd_retarget::shipped_config(robot)) {
-            (Some(path), _) => IkConfig::from_file(path)?,
-            (None, Some(config)) => config?,
-            (None, None) => {
-                bail!("--robot {robot} is not a shipped robot: give its IK config with --config")
-            }
-        };
-        let format = Format::from_path(Path::new(&format!("x.{format}")))
-            .with_context(|| format!("--format {format}: expected npz, csv, pkl or json"))?;
+        let config = crate::cmd_retarget::resolve_config(robot, config)?;
+        let format = crate::cmd_retarget::parse_format(Some(format))?
+            .context("an output format is required")?;
         Ok(Job {
             model: crate::shipped::robot_model(robot)?,
             config,

@@ -72,13 +72,7 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     };
     let format = parse_format(args.format.as_deref())?;
     let output = output_path(&input, args.output.as_deref(), format);
-    let config = match (&args.config, shipped_config(&robot)) {
-        (Some(path), _) => IkConfig::from_file(path)?,
-        (None, Some(config)) => config?,
-        (None, None) => {
-            bail!("--robot {robot} is not a shipped robot: give its IK config with --config")
-        }
-    };
+    let config = resolve_config(&robot, args.config.as_deref())?;
     let model = shipped::robot_model(&robot)?;
     let started = Instant::now();
     let options = RetargetOptions { human_height: args.human_height, ..RetargetOptions::default() };
@@ -243,7 +237,19 @@ fn c3d_human_motion(
     Ok((human, height, source))
 }
 
-fn parse_format(text: Option<&str>) -> anyhow::Result<Option<Format>> {
+/// The IK config at `path`, else the shipped default of robot `robot`.
+pub fn resolve_config(robot: &str, path: Option<&Path>) -> anyhow::Result<IkConfig> {
+    match (path, shipped_config(robot)) {
+        (Some(path), _) => Ok(IkConfig::from_file(path)?),
+        (None, Some(config)) => config,
+        (None, None) => {
+            bail!("--robot {robot} is not a shipped robot: give its IK config with --config")
+        }
+    }
+}
+
+/// `--format NAME` (npz, csv, pkl, json).
+pub fn parse_format(text: Option<&str>) -> anyhow::Result<Option<Format>> {
     let Some(text) = text else { return Ok(None) };
     match Format::from_path(Path::new(&format!("x.{text}"))) {
         Some(f) => Ok(Some(f)),
