@@ -165,6 +165,7 @@ fn write_g1_motion(path: &Path, frames: usize) -> mjcf::Model {
             pos,
             quat,
         }),
+        contacts: None,
     };
     retarget::writers::write_motion(path, &motion, &model, None).unwrap();
     model

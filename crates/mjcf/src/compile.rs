@@ -302,6 +302,7 @@ impl<'a> Compiler<'a> {
             range,
             axis,
             pos: Vector3::from(attrs.pos.unwrap_or_default()),
+            velocity_limit: None,
         };
         self.push_qpos0(&joint, &attrs);
         self.push_dofs(&joint);

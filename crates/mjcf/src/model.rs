@@ -99,6 +99,10 @@ pub struct Joint {
     pub axis: Vector3<f64>,
     /// Anchor in the body frame.
     pub pos: Vector3<f64>,
+    /// Published speed limit (rad/s for hinge, m/s for slide), when the robot's description
+    /// gives one (URDF `<limit velocity>`; MJCF has no such attribute, so `None` there unless
+    /// the caller sets it).
+    pub velocity_limit: Option<f64>,
 }
 
 /// A geom, placed in its body's frame.

@@ -14,6 +14,6 @@ pub mod targets;
 pub mod writers;
 
 pub use config::{IkConfig, MatchEntry};
-pub use motion::{RobotMotion, TrackedTargets};
+pub use motion::{FootContacts, RobotMotion, TrackedTargets};
 pub use pipeline::{retarget_bvh, retarget_motion, ClipDiagnostics, Error, RetargetOptions};
 pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};

@@ -13,6 +13,13 @@ pub struct TrackedTargets {
     pub quat: Vec<UnitQuaternion<f64>>,
 }
 
+/// Per frame, whether each foot of the source (the human) is in contact with the floor.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FootContacts {
+    pub left: Vec<bool>,
+    pub right: Vec<bool>,
+}
+
 /// Joint trajectories for one robot: `qpos` per frame in MuJoCo's layout.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotMotion {
@@ -28,6 +35,8 @@ pub struct RobotMotion {
     pub body_names: Vec<String>,
     /// What the solver tracked, when known.
     pub targets: Option<TrackedTargets>,
+    /// The source's foot contact phases, when known (npz `contact_left`, `contact_right`).
+    pub contacts: Option<FootContacts>,
 }
 
 impl RobotMotion {

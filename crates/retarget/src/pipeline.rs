@@ -208,6 +208,7 @@ pub fn retarget_motion(
             pos: target_pos,
             quat: target_quat,
         }),
+        contacts: None,
     };
     let weighted = |body: usize, pick: fn(&TaskSpec) -> f64| {
         stages.iter().flatten().any(|t| t.body == body && pick(t) != 0.0)

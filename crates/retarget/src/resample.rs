@@ -9,7 +9,7 @@
 use mjcf::{JointType, Model};
 use nalgebra::{Quaternion, UnitQuaternion};
 
-use crate::motion::{RobotMotion, TrackedTargets};
+use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 use crate::pipeline::Error;
 
 /// `motion` at `fps` frames per second. Joint types come from `model` (the motion's robot).
@@ -43,7 +43,15 @@ pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMo
         qpos.extend(blend_qpos(model, motion.frame(i), motion.frame(j), a));
     }
     let targets = motion.targets.as_ref().map(|t| resample_targets(t, &samples, frames));
-    Ok(RobotMotion { fps, qpos, targets, ..motion.clone() })
+    // A contact label is a state, not a quantity: take the nearer source frame's.
+    let nearest = |v: &[bool]| -> Vec<bool> {
+        samples.iter().map(|&(i, a)| v[if a < 0.5 { i } else { (i + 1).min(frames - 1) }]).collect()
+    };
+    let contacts = motion
+        .contacts
+        .as_ref()
+        .map(|c| FootContacts { left: nearest(&c.left), right: nearest(&c.right) });
+    Ok(RobotMotion { fps, qpos, targets, contacts, ..motion.clone() })
 }
 
 /// Linear blend of two configurations with slerp for the quaternion joints.
@@ -114,6 +122,7 @@ mod tests {
             joint_names: vec!["h".into()],
             body_names: vec!["b".into(), "c".into()],
             targets: None,
+            contacts: None,
         }
     }
 

@@ -23,6 +23,7 @@ fn motion_from(model: &mjcf::Model, qpos: Vec<f64>) -> RobotMotion {
         joint_names: model.joints.iter().skip(1).map(|j| j.name.clone()).collect(),
         body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
         targets: None,
+        contacts: None,
     }
 }
 

@@ -64,6 +64,7 @@ fn smooth_motion(model: &mjcf::Model, seed: u64) -> RobotMotion {
         joint_names: model.joints.iter().skip(1).map(|j| j.name.clone()).collect(),
         body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
         targets: Some(targets),
+        contacts: None,
     }
 }
 

@@ -1,8 +1,8 @@
 //! numpy's `.npy` format (NEP 1, format versions 1.0–3.0): a magic string, a Python-literal
 //! header dict (`descr`, `fortran_order`, `shape`) padded so the data starts at a multiple of
-//! 64 bytes, then the raw C-order data. We write float64 (`<f8`) and unicode (`<U`n: n
-//! UTF-32LE code units per element, NUL-padded) arrays, as `numpy.save` does, and read those
-//! plus `<f4`, `<i4`, `<i8` (converted to `f64`).
+//! 64 bytes, then the raw C-order data. We write float64 (`<f8`), bool (`|b1`) and unicode
+//! (`<U`n: n UTF-32LE code units per element, NUL-padded) arrays, as `numpy.save` does, and
+//! read those plus `<f4`, `<i4`, `<i8` (converted to `f64`).
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
@@ -11,6 +11,8 @@ const MAGIC: &[u8] = b"\x93NUMPY";
 pub enum ArrayData {
     F64(Vec<f64>),
     Str(Vec<String>),
+    /// numpy `bool` (`|b1`: one byte, 0 or 1).
+    Bool(Vec<bool>),
 }
 
 /// An n-dimensional array in C order.
@@ -25,6 +27,12 @@ impl Array {
     #[must_use]
     pub fn f64(shape: Vec<usize>, data: Vec<f64>) -> Array {
         Array { shape, data: ArrayData::F64(data) }
+    }
+
+    /// A 1-D boolean array.
+    #[must_use]
+    pub fn bools(items: &[bool]) -> Array {
+        Array { shape: vec![items.len()], data: ArrayData::Bool(items.to_vec()) }
     }
 
     /// A 1-D unicode array.
@@ -45,6 +53,7 @@ impl Array {
 pub fn encode(array: &Array) -> Vec<u8> {
     let (descr, width) = match &array.data {
         ArrayData::F64(_) => ("<f8".to_owned(), 8),
+        ArrayData::Bool(_) => ("|b1".to_owned(), 1),
         ArrayData::Str(items) => {
             let n = items.iter().map(|s| s.chars().count()).max().unwrap_or(0).max(1);
             (format!("<U{n}"), n)
@@ -74,6 +83,7 @@ pub fn encode(array: &Array) -> Vec<u8> {
         ArrayData::F64(values) => {
             values.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()))
         }
+        ArrayData::Bool(values) => out.extend(values.iter().map(|&v| u8::from(v))),
         ArrayData::Str(items) => {
             for item in items {
                 let mut n = 0;
@@ -91,6 +101,7 @@ pub fn encode(array: &Array) -> Vec<u8> {
 fn data_len(data: &ArrayData, width: usize) -> usize {
     match data {
         ArrayData::F64(v) => v.len() * 8,
+        ArrayData::Bool(v) => v.len(),
         ArrayData::Str(v) => v.len() * width * 4,
     }
 }
@@ -137,6 +148,7 @@ fn decode_data(descr: &str, body: &[u8], count: usize) -> Result<ArrayData, Stri
         "<f4" => floats(4, &|c| f64::from(f32::from_le_bytes(c.try_into().unwrap_or([0; 4])))),
         "<i8" => floats(8, &|c| i64::from_le_bytes(c.try_into().unwrap_or([0; 8])) as f64),
         "<i4" => floats(4, &|c| f64::from(i32::from_le_bytes(c.try_into().unwrap_or([0; 4])))),
+        "|b1" => Ok(ArrayData::Bool(need(1)?.iter().map(|&b| b != 0).collect())),
         d if d.starts_with("<U") => {
             let width: usize = d[2..].parse().map_err(|_| format!("bad dtype {d}"))?;
             if width == 0 {

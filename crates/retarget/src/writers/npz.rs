@@ -10,7 +10,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use super::npy::{self, Array, ArrayData};
 use super::{angular_velocity, body_poses, gradient_rows, root_nq, Error};
-use crate::motion::{RobotMotion, TrackedTargets};
+use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 
 /// The arrays of a motion's `.npz`, in file order (see [`super::write_motion`]).
 pub(crate) fn motion_arrays(
@@ -52,6 +52,10 @@ pub(crate) fn motion_arrays(
         arrays.push(("target_body_names", Array::strings(&targets.body_names)));
         arrays.push(("target_pos", Array::f64(vec![frames, k, 3], pos)));
         arrays.push(("target_quat", Array::f64(vec![frames, k, 4], wxyz_flat(&targets.quat))));
+    }
+    if let Some(contacts) = &motion.contacts {
+        arrays.push(("contact_left", Array::bools(&contacts.left)));
+        arrays.push(("contact_right", Array::bools(&contacts.right)));
     }
     arrays
 }
@@ -97,7 +101,8 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
 
 /// Reads a motion back from an `.npz` written by [`super::write_motion`] (or any `.npz` with
 /// `fps` (one number), `qpos` (T×nq), `joint_names`, `body_names` and optionally
-/// `target_body_names`, `target_pos` (T×K×3), `target_quat` (T×K×4, w first)).
+/// `target_body_names`, `target_pos` (T×K×3), `target_quat` (T×K×4, w first), and
+/// `contact_left`, `contact_right` (T bools)).
 pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
     let arrays = read_npz(path)?;
     let err = |message: String| Error::Read { path: path.to_path_buf(), message };
@@ -119,6 +124,11 @@ pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
             read_targets(names, get("target_pos")?, get("target_quat")?, *frames).map_err(err)?,
         ),
     };
+    let contacts = match (arrays.get("contact_left"), arrays.get("contact_right")) {
+        (None, None) => None,
+        (Some(l), Some(r)) => Some(read_contacts(l, r, *frames).map_err(err)?),
+        _ => return Err(err("only one of `contact_left` and `contact_right`".to_owned())),
+    };
     Ok(RobotMotion {
         fps,
         nq: *nq,
@@ -126,6 +136,7 @@ pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
         joint_names: joint_names.to_vec(),
         body_names: body_names.to_vec(),
         targets,
+        contacts,
     })
 }
 
@@ -167,17 +178,25 @@ fn read_targets(
     Ok(TrackedTargets { body_names: names.to_vec(), pos, quat })
 }
 
+fn read_contacts(left: &Array, right: &Array, frames: usize) -> Result<FootContacts, String> {
+    let side = |a: &Array, key: &str| match &a.data {
+        ArrayData::Bool(v) if a.shape == [frames] => Ok(v.clone()),
+        _ => Err(format!("`{key}` is not a bool array of {frames} frames")),
+    };
+    Ok(FootContacts { left: side(left, "contact_left")?, right: side(right, "contact_right")? })
+}
+
 fn floats(a: &Array) -> Option<&[f64]> {
     match &a.data {
         ArrayData::F64(v) => Some(v),
-        ArrayData::Str(_) => None,
+        ArrayData::Str(_) | ArrayData::Bool(_) => None,
     }
 }
 
 fn strings(a: &Array) -> Option<&[String]> {
     match &a.data {
         ArrayData::Str(v) => Some(v),
-        ArrayData::F64(_) => None,
+        ArrayData::F64(_) | ArrayData::Bool(_) => None,
     }
 }
 
@@ -190,6 +209,7 @@ mod tests {
         let arrays = [
             ("fps", Array::f64(vec![1], vec![30.0])),
             ("names", Array::strings(&["a".to_owned(), "bc".to_owned()])),
+            ("contact", Array::bools(&[true, false, false, true])),
         ];
         let mut buf = std::io::Cursor::new(Vec::new());
         write_npz(&mut buf, &arrays).unwrap();
@@ -200,6 +220,7 @@ mod tests {
         let back = read_npz(&path).unwrap();
         assert_eq!(back["fps"], arrays[0].1);
         assert_eq!(back["names"], arrays[1].1);
+        assert_eq!(back["contact"], arrays[2].1);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
