@@ -9,6 +9,11 @@
 //! `mj_jac`/`mj_jacBody` and `mj_integratePos`; the `mujoco` feature adds
 //! [`mujoco_check`], which compares everything with MuJoCo 3.17.0 itself.
 //!
+//! URDF is read into the same [`Model`] ([`Model::from_urdf_file`], [`Model::from_path`]) with
+//! the semantics of MuJoCo's URDF import (static links fused into their parent, visuals
+//! dropped, `rpy` as fixed-axis roll-pitch-yaw), plus a free root joint unless
+//! [`UrdfBase::Fixed`] is asked for; `<limit velocity>` becomes [`Joint::velocity_limit`].
+//!
 //! ```
 //! let xml = r#"<mujoco><worldbody><body name="a" pos="0 0 1">
 //!   <joint name="j" axis="0 1 0" range="-90 90"/><geom size="0.1"/>
