@@ -15,8 +15,9 @@
 //!   extension, accepted by MuJoCo) → ball.
 //! - `<limit lower upper>` → `range` when both are given and `lower < upper`, else unlimited
 //!   (MuJoCo); `continuous` joints are always unlimited (the URDF specification; MuJoCo would
-//!   limit a continuous joint that carries `lower`/`upper`). `<limit velocity>` (> 0) →
-//!   [`Joint::velocity_limit`], which MuJoCo has no field for. `qpos0` is zero for hinges and
+//!   limit a continuous joint that carries `lower`/`upper`). `<limit velocity>` →
+//!   [`Joint::velocity_limit`] (MuJoCo has no such field; `0`, which some exporters write for
+//!   "not given", and a missing one are `None`; a planar joint's applies to its three joints). `qpos0` is zero for hinges and
 //!   slides and the body pose for free joints.
 //! - Static links (no joint) are merged into their parent body, as MuJoCo's URDF default
 //!   `fusestatic="true"` does, the root link into the world when it has no joint; their
@@ -129,7 +130,7 @@ pub(crate) enum UrdfJointType {
 pub(crate) struct LimitSpec {
     pub lower: Option<f64>,
     pub upper: Option<f64>,
-    pub velocity: Option<(f64, Pos)>,
+    pub velocity: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -412,7 +413,7 @@ impl Parser<'_> {
                 if v < 0.0 {
                     return Err(self.src.invalid(attr_at(&a), "velocity must not be negative"));
                 }
-                Some((v, attr_at(&a)))
+                Some(v)
             }
             None => None,
         };
@@ -780,7 +781,8 @@ impl<'s> Builder<'s> {
         }
         let axis = if needs_axis { raw.normalize() } else { Vector3::z() };
         let limit = spec.limit.unwrap_or_default();
-        let velocity = limit.velocity.map(|(v, _)| v).filter(|&v| v > 0.0);
+        // Some exporters write velocity="0" for "not given"; a zero limit would freeze the joint.
+        let velocity = limit.velocity.filter(|&v| v > 0.0);
         // MuJoCo limits a joint when both bounds are written and lower < upper; else unlimited.
         let range = match (limit.lower, limit.upper) {
             (Some(lo), Some(hi)) if lo < hi => Some([lo, hi]),
@@ -888,5 +890,60 @@ impl<'s> Builder<'s> {
         m.jnt_pos_zero = vec![true; m.joints.len()];
         m.geom_mat = m.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
         m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn builder_names(files: &[(&str, [f64; 3])]) -> Vec<String> {
+        let src = Sources::default();
+        let mut b = Builder::new(String::new(), &src);
+        files.iter().map(|(f, scale)| b.mesh_name(f, *scale)).collect()
+    }
+
+    #[test]
+    fn mesh_names_follow_mujoco() {
+        let names = builder_names(&[
+            ("package://g1/meshes/foot.STL", [1.0; 3]),
+            ("meshes\\foot.stl", [1.0; 3]),
+            ("foot.obj", [0.5; 3]),
+            ("hand", [1.0; 3]),
+        ]);
+        assert_eq!(names, ["foot", "foot", "foot1", "hand"]);
+    }
+
+    #[test]
+    fn rpy_is_roll_pitch_yaw_about_fixed_axes() {
+        let o = Origin { xyz: [1.0, 2.0, 3.0], rpy: [0.1, -0.2, 0.3] };
+        let f = origin_frame(&o);
+        let expected = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.3)
+            * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -0.2)
+            * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.1);
+        assert!(f.quat.angle_to(&expected) < 1e-15);
+        assert_eq!(f.pos, Vector3::new(1.0, 2.0, 3.0));
+    }
+
+    #[test]
+    fn limits_need_both_bounds_in_order() {
+        let urdf = |limit: &str| {
+            format!(
+                r#"<robot name="r"><link name="a"/><link name="b"/>
+                   <joint name="j" type="prismatic"><parent link="a"/><child link="b"/>{limit}</joint></robot>"#
+            )
+        };
+        for (limit, range, speed) in [
+            ("", None, None),
+            (r#"<limit lower="-0.1" upper="0.2" velocity="1.5"/>"#, Some([-0.1, 0.2]), Some(1.5)),
+            (r#"<limit lower="-0.1" velocity="0"/>"#, None, None),
+            (r#"<limit upper="0.2"/>"#, None, None),
+            (r#"<limit lower="0.2" upper="0.2"/>"#, None, None),
+            (r#"<limit lower="0.3" upper="0.2"/>"#, None, None),
+        ] {
+            let options = UrdfOptions { base: UrdfBase::Fixed, fuse_static: None };
+            let m = Model::from_urdf_str(&urdf(limit), options).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!((m.joints[0].range, m.joints[0].velocity_limit), (range, speed), "{limit}");
+        }
     }
 }
