@@ -491,7 +491,7 @@ fn origin_frame(o: &Origin) -> Frame {
     Frame { pos: Vector3::from(o.xyz), quat }
 }
 
-/// The link tree: parent joint of each link, child joints of each link in file order.
+/// The link tree: parent joint and parent link of each link, and the depth-first order.
 struct Tree {
     root: usize,
     parent_joint: Vec<Option<usize>>,
