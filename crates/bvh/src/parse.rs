@@ -37,15 +37,16 @@ pub fn parse(src: &[u8]) -> Result<Bvh, Error> {
 /// present: the rows win, with a [`Warning::FrameCount`] (Biovision's exports are often one
 /// off). Warnings: the frame count's first, then one per joint with scale channels.
 pub fn parse_with_warnings(src: &[u8]) -> Result<(Bvh, Vec<Warning>), Error> {
-    let mut p = Parser { src, pos: 0, warnings: Vec::new(), scaled: Vec::new() };
+    let mut p = Parser { src, pos: 0 };
     if src.starts_with(b"\xEF\xBB\xBF") {
         p.pos = 3; // UTF-8 byte order mark, as some Windows tools write
     }
-    let skeleton = p.hierarchy()?;
-    let motion = p.motion(skeleton.num_channels())?;
+    let mut scaled = Vec::new();
+    let skeleton = p.hierarchy(&mut scaled)?;
+    let (motion, frame_count) = p.motion(skeleton.num_channels())?;
     let bvh = Bvh { skeleton, motion };
-    let mut warnings = p.warnings;
-    warnings.extend(scale_warnings(src, &bvh, &p.scaled));
+    let mut warnings: Vec<Warning> = frame_count.into_iter().collect();
+    warnings.extend(scale_warnings(src, &bvh, &scaled));
     Ok((bvh, warnings))
 }
 
@@ -72,9 +73,6 @@ fn scale_warnings(src: &[u8], bvh: &Bvh, scaled: &[(usize, usize)]) -> Vec<Warni
 struct Parser<'a> {
     src: &'a [u8],
     pos: usize,
-    warnings: Vec<Warning>,
-    /// Joints with scale channels: (joint index, offset of its `CHANNELS` keyword).
-    scaled: Vec<(usize, usize)>,
 }
 
 /// A joint whose `{` has been read and whose `}` has not.
@@ -216,12 +214,14 @@ impl<'a> Parser<'a> {
 
     // ---- HIERARCHY -------------------------------------------------------------------------
 
-    fn hierarchy(&mut self) -> Result<Skeleton, Error> {
+    /// The HIERARCHY block; joints with scale channels go to `scaled` as (joint index,
+    /// offset of their `CHANNELS` keyword).
+    fn hierarchy(&mut self, scaled: &mut Vec<(usize, usize)>) -> Result<Skeleton, Error> {
         self.expect_keyword("HIERARCHY", "`HIERARCHY`")?;
         let mut skeleton = Skeleton::default();
         loop {
             match self.token() {
-                (_, Some(t)) if is_keyword(t, "ROOT") => self.joint_tree(&mut skeleton)?,
+                (_, Some(t)) if is_keyword(t, "ROOT") => self.joint_tree(&mut skeleton, scaled)?,
                 (_, Some(t)) if is_keyword(t, "MOTION") && !skeleton.joints.is_empty() => {
                     return Ok(skeleton)
                 }
@@ -233,7 +233,11 @@ impl<'a> Parser<'a> {
     }
 
     /// One ROOT and everything below it (the `ROOT` keyword has been read).
-    fn joint_tree(&mut self, skeleton: &mut Skeleton) -> Result<(), Error> {
+    fn joint_tree(
+        &mut self,
+        skeleton: &mut Skeleton,
+        scaled: &mut Vec<(usize, usize)>,
+    ) -> Result<(), Error> {
         let mut stack = vec![self.open(skeleton, JointKind::Root, None)?];
         while let Some(top) = stack.last_mut() {
             let id = top.id;
@@ -262,7 +266,7 @@ impl<'a> Parser<'a> {
                     top.has_channels = true;
                     let channels = self.channels(at)?;
                     if channels.iter().any(|c| matches!(c, Channel::Scale(_))) {
-                        self.scaled.push((id, at));
+                        scaled.push((id, at));
                     }
                     let first = skeleton.num_channels();
                     let joint = &mut skeleton.joints[id];
@@ -415,16 +419,18 @@ impl<'a> Parser<'a> {
 
     // ---- MOTION ----------------------------------------------------------------------------
 
-    fn motion(&mut self, num_channels: usize) -> Result<Motion, Error> {
+    /// The MOTION block, and the warning for a `Frames:` count that the rows contradict.
+    fn motion(&mut self, num_channels: usize) -> Result<(Motion, Option<Warning>), Error> {
         let (declared, count_at) = self.labelled_count()?;
         let frame_time = self.frame_time()?;
         self.end_of_line()?;
         let (values, num_frames) = self.rows(declared, num_channels)?;
-        if num_frames != declared {
-            let pos = self.at(count_at);
-            self.warnings.push(Warning::FrameCount { pos, declared, found: num_frames });
-        }
-        Ok(Motion { frame_time, num_frames, num_channels, values })
+        let warning = (num_frames != declared).then(|| Warning::FrameCount {
+            pos: self.at(count_at),
+            declared,
+            found: num_frames,
+        });
+        Ok((Motion { frame_time, num_frames, num_channels, values }, warning))
     }
 
     /// `Frames: n` (also `Frames:n`): the count and its offset.
