@@ -50,10 +50,10 @@ pub enum Error {
     /// `CHANNELS n` followed by a different number of channel names.
     #[error("{pos}: CHANNELS declares {declared} channels but names {found}")]
     ChannelCount { pos: Pos, declared: usize, found: usize },
-    /// A channel name other than the six BVH knows.
+    /// A channel name other than the six BVH knows and the three scale channels.
     #[error(
         "{pos}: unknown channel `{name}`, expected Xposition, Yposition, Zposition, \
-         Xrotation, Yrotation or Zrotation"
+         Xrotation, Yrotation, Zrotation, Xscale, Yscale or Zscale"
     )]
     UnknownChannel { pos: Pos, name: String },
     /// A token that should be a number and is not.
@@ -65,12 +65,6 @@ pub enum Error {
     /// A motion row with too few or too many values (`frame` counts from 1).
     #[error("{pos}: frame {frame} has {found} values, expected {expected}")]
     FrameLength { pos: Pos, frame: usize, found: usize, expected: usize },
-    /// The file ends before the number of rows `Frames:` declares.
-    #[error("{pos}: `Frames:` declares {declared} frames but the file has {found}")]
-    TooFewFrames { pos: Pos, declared: usize, found: usize },
-    /// A row after the last frame `Frames:` declares.
-    #[error("{pos}: more frames than the {declared} that `Frames:` declares")]
-    TooManyFrames { pos: Pos, declared: usize },
     /// Structurally well-formed but meaningless (duplicate OFFSET, zero frame time, …).
     #[error("{pos}: {what}")]
     Invalid { pos: Pos, what: &'static str },
@@ -96,8 +90,6 @@ impl Error {
             | Error::NotANumber { pos, .. }
             | Error::NonFinite { pos, .. }
             | Error::FrameLength { pos, .. }
-            | Error::TooFewFrames { pos, .. }
-            | Error::TooManyFrames { pos, .. }
             | Error::Invalid { pos, .. } => Some(*pos),
             Error::Io { .. } => None,
             Error::InFile { inner, .. } => inner.position(),

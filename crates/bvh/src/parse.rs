@@ -18,16 +18,56 @@
 use crate::error::{Error, Pos};
 use crate::float::{is_space, parse_number, token_end};
 use crate::skeleton::{Bvh, Channel, Joint, JointId, JointKind, Motion, Skeleton};
+use crate::warning::Warning;
 
-/// Parse a whole BVH file held in memory.
+/// Parse a whole BVH file held in memory (see [`parse_with_warnings`] for what it
+/// tolerates and reports).
 pub fn parse(src: &[u8]) -> Result<Bvh, Error> {
+    parse_with_warnings(src).map(|(bvh, _)| bvh)
+}
+
+/// Parse a whole BVH file held in memory, with the quirks that were read anyway.
+///
+/// Real exporters' files parse (each case has a fixture in `tests/data/quirk_*`): names padded
+/// with spaces or tabs (trimmed), tabs wherever a space may be (after `Frames:` and
+/// `Frame Time:`, between values), three-digit exponents (`1e-015`, from MSVC's `printf`),
+/// joints with channels and no End Site, any positive Frame Time (119.875 fps stays 119.875),
+/// position channels on any joint (their meaning is `fk`'s business), scale channels (kept,
+/// with a [`Warning::ScaleChannels`]) and a `Frames:` count that disagrees with the rows
+/// present: the rows win, with a [`Warning::FrameCount`] (Biovision's exports are often one
+/// off). Warnings: the frame count's first, then one per joint with scale channels.
+pub fn parse_with_warnings(src: &[u8]) -> Result<(Bvh, Vec<Warning>), Error> {
     let mut p = Parser { src, pos: 0 };
     if src.starts_with(b"\xEF\xBB\xBF") {
         p.pos = 3; // UTF-8 byte order mark, as some Windows tools write
     }
-    let skeleton = p.hierarchy()?;
-    let motion = p.motion(skeleton.num_channels())?;
-    Ok(Bvh { skeleton, motion })
+    let mut scaled = Vec::new();
+    let skeleton = p.hierarchy(&mut scaled)?;
+    let (motion, frame_count) = p.motion(skeleton.num_channels())?;
+    let bvh = Bvh { skeleton, motion };
+    let mut warnings: Vec<Warning> = frame_count.into_iter().collect();
+    warnings.extend(scale_warnings(src, &bvh, &scaled));
+    Ok((bvh, warnings))
+}
+
+/// One warning per joint with scale channels: (joint index, offset of its `CHANNELS`).
+fn scale_warnings(src: &[u8], bvh: &Bvh, scaled: &[(usize, usize)]) -> Vec<Warning> {
+    let m = &bvh.motion;
+    scaled
+        .iter()
+        .map(|&(id, at)| {
+            let joint = &bvh.skeleton.joints[id];
+            let columns = (joint.channels.iter().enumerate())
+                .filter(|(_, c)| matches!(c, Channel::Scale(_)))
+                .map(|(k, _)| joint.first_channel + k);
+            let values = columns.flat_map(|c| (0..m.num_frames).map(move |f| m.frame(f)[c]));
+            let range = values
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+            let (min, max) = if range.0 <= range.1 { range } else { (1.0, 1.0) };
+            let pos = Pos::from_offset(src, at);
+            Warning::ScaleChannels { pos, joint: joint.name.clone(), min, max }
+        })
+        .collect()
 }
 
 struct Parser<'a> {
@@ -174,12 +214,14 @@ impl<'a> Parser<'a> {
 
     // ---- HIERARCHY -------------------------------------------------------------------------
 
-    fn hierarchy(&mut self) -> Result<Skeleton, Error> {
+    /// The HIERARCHY block; joints with scale channels go to `scaled` as (joint index,
+    /// offset of their `CHANNELS` keyword).
+    fn hierarchy(&mut self, scaled: &mut Vec<(usize, usize)>) -> Result<Skeleton, Error> {
         self.expect_keyword("HIERARCHY", "`HIERARCHY`")?;
         let mut skeleton = Skeleton::default();
         loop {
             match self.token() {
-                (_, Some(t)) if is_keyword(t, "ROOT") => self.joint_tree(&mut skeleton)?,
+                (_, Some(t)) if is_keyword(t, "ROOT") => self.joint_tree(&mut skeleton, scaled)?,
                 (_, Some(t)) if is_keyword(t, "MOTION") && !skeleton.joints.is_empty() => {
                     return Ok(skeleton)
                 }
@@ -191,7 +233,11 @@ impl<'a> Parser<'a> {
     }
 
     /// One ROOT and everything below it (the `ROOT` keyword has been read).
-    fn joint_tree(&mut self, skeleton: &mut Skeleton) -> Result<(), Error> {
+    fn joint_tree(
+        &mut self,
+        skeleton: &mut Skeleton,
+        scaled: &mut Vec<(usize, usize)>,
+    ) -> Result<(), Error> {
         let mut stack = vec![self.open(skeleton, JointKind::Root, None)?];
         while let Some(top) = stack.last_mut() {
             let id = top.id;
@@ -219,6 +265,9 @@ impl<'a> Parser<'a> {
                     }
                     top.has_channels = true;
                     let channels = self.channels(at)?;
+                    if channels.iter().any(|c| matches!(c, Channel::Scale(_))) {
+                        scaled.push((id, at));
+                    }
                     let first = skeleton.num_channels();
                     let joint = &mut skeleton.joints[id];
                     joint.first_channel = first;
@@ -370,21 +419,30 @@ impl<'a> Parser<'a> {
 
     // ---- MOTION ----------------------------------------------------------------------------
 
-    fn motion(&mut self, num_channels: usize) -> Result<Motion, Error> {
-        let num_frames = self.labelled_count()?;
+    /// The MOTION block, and the warning for a `Frames:` count that the rows contradict.
+    fn motion(&mut self, num_channels: usize) -> Result<(Motion, Option<Warning>), Error> {
+        let (declared, count_at) = self.labelled_count()?;
         let frame_time = self.frame_time()?;
         self.end_of_line()?;
-        let values = self.rows(num_frames, num_channels)?;
-        Ok(Motion { frame_time, num_frames, num_channels, values })
+        let (values, num_frames) = self.rows(declared, num_channels)?;
+        let warning = (num_frames != declared).then(|| Warning::FrameCount {
+            pos: self.at(count_at),
+            declared,
+            found: num_frames,
+        });
+        Ok((Motion { frame_time, num_frames, num_channels, values }, warning))
     }
 
-    /// `Frames: n` (also `Frames:n`).
-    fn labelled_count(&mut self) -> Result<usize, Error> {
+    /// `Frames: n` (also `Frames:n`): the count and its offset.
+    fn labelled_count(&mut self) -> Result<(usize, usize), Error> {
         let (at, token) = self.token();
-        let glued = token.and_then(|t| strip_prefix_ignore_case(t, b"Frames:"));
-        match glued {
-            Some([]) => self.count("a frame count after `Frames:`"),
-            Some(rest) => self.integer(at + 7, Some(rest), "a frame count after `Frames:`"),
+        let expected = "a frame count after `Frames:`";
+        match token.and_then(|t| strip_prefix_ignore_case(t, b"Frames:")) {
+            Some([]) => {
+                let (at, token) = self.token();
+                Ok((self.integer(at, token, expected)?, at))
+            }
+            Some(rest) => Ok((self.integer(at + 7, Some(rest), expected)?, at + 7)),
             None => Err(self.expected(at, "`Frames:`", token)),
         }
     }
@@ -423,8 +481,9 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// The motion rows, straight into one `frames × channels` buffer.
-    fn rows(&mut self, num_frames: usize, num_channels: usize) -> Result<Vec<f64>, Error> {
+    /// The motion rows, straight into one `frames × channels` buffer, and how many there
+    /// are. `declared` (the `Frames:` count) only sizes the buffer: the rows present count.
+    fn rows(&mut self, declared: usize, num_channels: usize) -> Result<(Vec<f64>, usize), Error> {
         if num_channels == 0 {
             // Rows would be empty lines, which cannot be counted: allow no frames at all.
             let (at, token) = self.token();
@@ -432,15 +491,15 @@ impl<'a> Parser<'a> {
                 Some(_) => {
                     Err(self.expected(at, "end of file (the skeleton has no channels)", token))
                 }
-                None if num_frames > 0 => {
+                None if declared > 0 => {
                     Err(Error::Invalid { pos: self.at(at), what: "frames but no channels" })
                 }
-                None => Ok(Vec::new()),
+                None => Ok((Vec::new(), 0)),
             };
         }
         // Never trust the header for the allocation: each value takes at least two bytes.
         let room = (self.src.len() - self.pos) / 2 + 1;
-        let mut values = Vec::with_capacity(num_frames.saturating_mul(num_channels).min(room));
+        let mut values = Vec::with_capacity(declared.saturating_mul(num_channels).min(room));
         let mut frame = 0;
         loop {
             self.skip_inline_space();
@@ -450,25 +509,12 @@ impl<'a> Parser<'a> {
                     self.pos += 1;
                     continue;
                 }
-                Some(_) if frame == num_frames => {
-                    return Err(Error::TooManyFrames {
-                        pos: self.at(self.pos),
-                        declared: num_frames,
-                    });
-                }
                 Some(_) => {}
             }
             frame += 1;
             self.row(&mut values, frame, num_channels)?;
         }
-        if frame < num_frames {
-            return Err(Error::TooFewFrames {
-                pos: self.at(self.pos),
-                declared: num_frames,
-                found: frame,
-            });
-        }
-        Ok(values)
+        Ok((values, frame))
     }
 
     /// One row (frame number `frame`, from 1) ending at a newline or the end of the file.

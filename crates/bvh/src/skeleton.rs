@@ -18,6 +18,10 @@ pub enum Channel {
     Position(Axis),
     /// Rotation in degrees about the joint's local axis.
     Rotation(Axis),
+    /// Scale along the joint's local axis (`Xscale`, written by some Maya and MotionBuilder
+    /// exporters, usually 1). Kept so that files round-trip; `fk` does not apply it and the
+    /// parser warns about it ([`crate::Warning::ScaleChannels`]).
+    Scale(Axis),
 }
 
 impl Channel {
@@ -31,6 +35,9 @@ impl Channel {
             Channel::Rotation(Axis::X) => "Xrotation",
             Channel::Rotation(Axis::Y) => "Yrotation",
             Channel::Rotation(Axis::Z) => "Zrotation",
+            Channel::Scale(Axis::X) => "Xscale",
+            Channel::Scale(Axis::Y) => "Yscale",
+            Channel::Scale(Axis::Z) => "Zscale",
         }
     }
 
@@ -44,6 +51,9 @@ impl Channel {
             "Xrotation" => Channel::Rotation(Axis::X),
             "Yrotation" => Channel::Rotation(Axis::Y),
             "Zrotation" => Channel::Rotation(Axis::Z),
+            "Xscale" => Channel::Scale(Axis::X),
+            "Yscale" => Channel::Scale(Axis::Y),
+            "Zscale" => Channel::Scale(Axis::Z),
             _ => return None,
         })
     }

@@ -142,7 +142,7 @@ fn rotation_order(channels: &[Channel]) -> String {
         .iter()
         .filter_map(|c| match c {
             Channel::Rotation(a) => Some(axis_name(*a)),
-            Channel::Position(_) => None,
+            Channel::Position(_) | Channel::Scale(_) => None,
         })
         .collect()
 }
@@ -212,7 +212,7 @@ impl fmt::Display for Summary {
     }
 }
 
-/// `pos XYZ rot ZYX` for a joint's channels, in file order.
+/// `pos XYZ rot ZYX` (`scale XYZ`) for a joint's channels, in file order.
 fn layout_short(channels: &[Channel]) -> String {
     let mut out = String::new();
     let mut last = None;
@@ -220,6 +220,7 @@ fn layout_short(channels: &[Channel]) -> String {
         let (word, axis) = match c {
             Channel::Position(a) => ("pos", a),
             Channel::Rotation(a) => ("rot", a),
+            Channel::Scale(a) => ("scale", a),
         };
         if last != Some(word) {
             if !out.is_empty() {

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use fk::{AxisConvention, FkOptions, FkReport, UnitChoice};
+use fk::{AxisConvention, FkOptions, FkReport, PositionReading, UnitChoice};
 
 /// Arguments of `retarget bvh fk`.
 #[derive(Args, Debug, Clone)]
@@ -77,7 +77,7 @@ pub fn run(args: &FkArgs) -> anyhow::Result<ExitCode> {
 
 /// Print every body's world pose at `frame`, then the [`FkReport`].
 pub fn print_fk(file: &Path, frame: usize, options: &FkOptions) -> anyhow::Result<ExitCode> {
-    let bvh = bvh::from_path(file)?;
+    let bvh = crate::cmd_bvh::read_bvh(file)?;
     let poses = frame_poses(&bvh, frame, options).with_context(|| file.display().to_string())?;
     println!("{}: {}", file.display(), poses.header());
     for line in poses.lines() {
@@ -93,11 +93,21 @@ pub fn report_lines(bvh: &bvh::Bvh) -> anyhow::Result<Vec<String>> {
 }
 
 fn summary_lines(report: &FkReport) -> Vec<String> {
-    vec![
+    let mut lines = vec![
         format!("units: {} m per file unit ({})", report.metres_per_unit, report.unit_reason),
         format!("subject height: {:.3} m ({})", report.height, report.height_source),
         format!("ground: {:.4} m (lowest foot point over the clip, Z up)", report.ground),
-    ]
+    ];
+    // GMR's reading (channels replace OFFSET) goes without saying; the others are news.
+    let unusual = report.position_channels.iter().filter(|p| p.reading != PositionReading::Local);
+    lines.extend(unusual.map(|p| {
+        let reading = match p.reading {
+            PositionReading::Added => "a displacement added to OFFSET",
+            _ => "world positions",
+        };
+        format!("position channels of `{}`: {reading} ({})", p.joint, p.reason)
+    }));
+    lines
 }
 
 /// One body's world pose.

@@ -87,7 +87,8 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         diag.human_height_source = source;
         (motion, diag)
     } else {
-        let bvh = bvh::from_path(&input).with_context(|| format!("{}", input.display()))?;
+        let bvh =
+            crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
         retarget::retarget_bvh(&bvh, &model, &config, &options)
             .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
     };

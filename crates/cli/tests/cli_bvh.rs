@@ -122,3 +122,24 @@ fn usage_errors_exit_2() {
     let out = retarget(&["bvh".as_ref(), "json".as_ref(), "a.bvh".as_ref(), "--bogus".as_ref()]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn warnings_go_to_stderr_one_line_each_prefixed_by_the_file() {
+    let file = fixture("quirk_frames_one_more_than_rows.bvh");
+    let out = retarget(&["bvh".as_ref(), "info".as_ref(), file.as_os_str()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        text(&out.stderr),
+        format!(
+            "{}:17:9: warning: `Frames:` declares 3 frames but the file has 2; using the 2 \
+             present\n",
+            file.display()
+        )
+    );
+    assert!(text(&out.stdout).contains("frames:          2\n"));
+    // `bvh cat` writes the rows present, so its output parses without the warning.
+    let out = retarget(&["bvh".as_ref(), "cat".as_ref(), file.as_os_str()]);
+    assert_eq!(text(&out.stderr).lines().count(), 1);
+    let (_, warnings) = bvh::parse_with_warnings(&out.stdout).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+}

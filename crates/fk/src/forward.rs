@@ -3,15 +3,71 @@
 //!
 //! Per joint, as GMR's LAFAN1 loader (`read_bvh` + `quat_fk`) does it:
 //! `q_local = q(c₁) ⊗ q(c₂) ⊗ q(c₃)` in the joint's channel order, `p_local` = its position
-//! channels (replacing OFFSET) or OFFSET; `q = q_parent ⊗ q_local`,
-//! `p = q_parent · p_local + p_parent`. World: `p' = R_axes · p · metres_per_unit`,
-//! `q' = q_axes ⊗ q`.
+//! channels read as [`PositionReading`] says (GMR: they replace OFFSET) or OFFSET;
+//! `q = q_parent ⊗ q_local`, `p = q_parent · p_local + p_parent` (a [`PositionReading::World`]
+//! joint: `p = p_local`). World: `p' = R_axes · p · metres_per_unit`, `q' = q_axes ⊗ q`.
 
 use bvh::{Axis, Bvh, Channel, JointKind};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use crate::math::{self, Quat};
 use crate::{AxisConvention, Error};
+
+/// How a joint's position channels are read. The BVH format does not say and exporters
+/// differ, so `fk` decides per joint and per clip from the numbers, parents first, and reports
+/// the choice in [`crate::FkReport::position_channels`]. With `c` a joint's position channels
+/// and `o` its OFFSET (axes without a channel are left out of both):
+///
+/// 1. Frame 0 repeats the OFFSET (`|c − o|` within 1e-3 of `|o|` or of the mean bone length,
+///    whichever is larger) → [`PositionReading::Local`]. LAFAN1 writes its root's first
+///    position as the root OFFSET; Bandai Namco and Blender write every non-root joint's OFFSET
+///    again in its channels.
+/// 2. A non-root joint with all three position channels whose values, in more than half of
+///    the frames (at most 256, spread over the clip), lie at least 4 times nearer the world
+///    position its parent's pose and OFFSET predict (`p_parent + q_parent · o`) than they lie
+///    to either `o` or zero → [`PositionReading::World`].
+/// 3. Otherwise the one axis that tells the two local readings apart best decides: the
+///    channel whose median absolute deviation over those frames is smallest for the size of
+///    its OFFSET component (for a root: the height, not the floor plan it walks). Its median
+///    nearer that component than zero → [`PositionReading::Local`], else
+///    [`PositionReading::Added`].
+///
+/// A zero OFFSET makes `Local` and `Added` the same numbers (CMU, Mixamo): `Local` is chosen.
+/// Channels read as `Local` give exactly GMR's numbers, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PositionReading {
+    /// The channels are the joint's position in its parent's frame: they replace OFFSET (GMR's
+    /// and Blender's reading, and what Blender, LAFAN1 and Bandai Namco write: Bandai's Hips
+    /// under a still floor root carry the whole translation, height included). Adding OFFSET
+    /// to these would put the hips at twice their height.
+    Local,
+    /// The channels are a displacement added to OFFSET: the root as Biovision's format is
+    /// usually described ("the sum of the offset data and the translation data"). A Rigify
+    /// export whose pelvis OFFSET is its standing height and whose channels are centimetres of
+    /// sway is one; read as `Local` its feet would sink a pelvis height below the floor.
+    Added,
+    /// The channels are the joint's position in the file's world frame (exporters that write
+    /// every joint's global position): the joint is put there; its orientation still chains
+    /// from its parent.
+    World,
+}
+
+/// The reading chosen for one joint with position channels, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PositionChannels {
+    pub joint: String,
+    pub reading: PositionReading,
+    /// What decided it, e.g. "frame 0 repeats the OFFSET".
+    pub reason: String,
+}
+
+/// At most this many frames, spread over the clip, decide a joint's [`PositionReading`].
+const MAX_VOTERS: usize = 256;
+/// How much nearer its predicted world position than either local reading a frame's position
+/// channels must be to count for [`PositionReading::World`].
+const WORLD_MARGIN: f64 = 4.0;
+/// Frame 0 "repeats the OFFSET" within this fraction of `max(|OFFSET|, mean bone length)`.
+const REPEAT_TOLERANCE: f64 = 1e-3;
 
 /// One joint, compiled for the loop.
 #[derive(Debug, Clone)]
@@ -20,14 +76,56 @@ struct JointPlan {
     offset: [f64; 3],
     /// Column of each position channel, per axis; `None` keeps the OFFSET component.
     position_columns: [Option<usize>; 3],
+    reading: PositionReading,
     /// Rotation channels in file order: (axis, column).
     rotations: Vec<(Axis, usize)>,
+}
+
+impl JointPlan {
+    fn has_positions(&self) -> bool {
+        self.position_columns.iter().any(Option::is_some)
+    }
+
+    /// The channel values of the axes that have position channels (0 elsewhere).
+    fn channels(&self, values: &[f64]) -> [f64; 3] {
+        self.position_columns.map(|c| c.map_or(0.0, |c| values[c]))
+    }
+
+    /// Global pose from this frame's `row` and the parent's global pose.
+    #[inline]
+    fn pose(&self, row: &Row, parent: Option<(Quat, [f64; 3])>) -> (Quat, [f64; 3]) {
+        let mut local_p = self.offset;
+        for (c, column) in self.position_columns.iter().enumerate() {
+            if let Some(column) = column {
+                local_p[c] = match self.reading {
+                    PositionReading::Added => self.offset[c] + row.values[*column],
+                    PositionReading::Local | PositionReading::World => row.values[*column],
+                };
+            }
+        }
+        // q(a₁) ⊗ (q(a₂) ⊗ q(a₃)): fold from the right (`math::euler_quat`).
+        let local_q = self.rotations.iter().rev().fold(math::IDENTITY, |q, &(axis, col)| {
+            math::axis_mul(axis, row.cos[col], row.sin[col], &q)
+        });
+        match parent {
+            None => (local_q, local_p),
+            Some((pq, _)) if self.reading == PositionReading::World => {
+                (math::quat_mul(&pq, &local_q), local_p)
+            }
+            Some((pq, pp)) => {
+                let r = math::quat_rotate(&pq, local_p);
+                (math::quat_mul(&pq, &local_q), [r[0] + pp[0], r[1] + pp[1], r[2] + pp[2]])
+            }
+        }
+    }
 }
 
 /// The skeleton compiled for FK; built once per clip, after validation.
 #[derive(Debug, Clone)]
 pub(crate) struct Plan {
     joints: Vec<JointPlan>,
+    /// The reading of every joint with position channels, in joint order.
+    position_channels: Vec<PositionChannels>,
 }
 
 impl Plan {
@@ -54,7 +152,14 @@ impl Plan {
             .enumerate()
             .map(|(index, joint)| compile_joint(index, joint, motion.num_channels))
             .collect::<Result<_, _>>()?;
-        Ok(Plan { joints })
+        let mut plan = Plan { joints, position_channels: Vec::new() };
+        plan.decide_readings(bvh);
+        Ok(plan)
+    }
+
+    /// How each joint's position channels were read ([`PositionReading`]).
+    pub(crate) fn position_channels(&self) -> &[PositionChannels] {
+        &self.position_channels
     }
 
     pub(crate) fn num_joints(&self) -> usize {
@@ -76,28 +181,7 @@ impl Plan {
     #[inline]
     pub(crate) fn global(&self, row: &Row, q: &mut [Quat], p: &mut [[f64; 3]]) {
         for (i, joint) in self.joints.iter().enumerate() {
-            let mut local_p = joint.offset;
-            for (c, column) in joint.position_columns.iter().enumerate() {
-                if let Some(column) = column {
-                    local_p[c] = row.values[*column];
-                }
-            }
-            // q(a₁) ⊗ (q(a₂) ⊗ q(a₃)): fold from the right (`math::euler_quat`).
-            let local_q = joint.rotations.iter().rev().fold(math::IDENTITY, |q, &(axis, col)| {
-                math::axis_mul(axis, row.cos[col], row.sin[col], &q)
-            });
-            match joint.parent {
-                None => {
-                    q[i] = local_q;
-                    p[i] = local_p;
-                }
-                Some(parent) => {
-                    let (pq, pp) = (q[parent], p[parent]);
-                    let r = math::quat_rotate(&pq, local_p);
-                    q[i] = math::quat_mul(&pq, &local_q);
-                    p[i] = [r[0] + pp[0], r[1] + pp[1], r[2] + pp[2]];
-                }
-            }
+            (q[i], p[i]) = joint.pose(row, joint.parent.map(|j| (q[j], p[j])));
         }
     }
 
@@ -109,13 +193,184 @@ impl Plan {
                 .iter()
                 .map(|j| JointPlan {
                     position_columns: [None; 3],
+                    reading: PositionReading::Local,
                     rotations: Vec::new(),
                     ..j.clone()
                 })
                 .collect(),
+            position_channels: Vec::new(),
         };
         rest.global(&Row::default(), q, p);
     }
+}
+
+impl Plan {
+    /// Decide every joint's [`PositionReading`], parents first, from frame 0 and up to
+    /// [`MAX_VOTERS`] frames; a sample's parent poses come from the readings already decided.
+    fn decide_readings(&mut self, bvh: &Bvh) {
+        let motion = &bvh.motion;
+        if motion.num_frames == 0 || !self.joints.iter().any(JointPlan::has_positions) {
+            return;
+        }
+        let scale = mean_bone_length(&self.joints);
+        let with_positions = self.joints.iter().filter(|j| j.has_positions());
+        // Frame 0 settles every joint of most files (LAFAN1, Bandai): then it is the only sample.
+        let settled = with_positions.clone().all(|j| j.repeats_offset(motion.frame(0), scale));
+        let samples = if settled { vec![0] } else { sample_frames(motion.num_frames) };
+        let rows: Vec<Row> = samples
+            .iter()
+            .map(|&f| {
+                let mut row = Row::default();
+                row.load(motion.frame(f));
+                row
+            })
+            .collect();
+        let n = self.joints.len();
+        // Global pose of joint i in sample s at [s * n + i].
+        let mut poses = vec![(math::IDENTITY, [0.0; 3]); rows.len() * n];
+        for i in 0..n {
+            if self.joints[i].has_positions() {
+                let parents: Option<Vec<(Quat, [f64; 3])>> = self.joints[i]
+                    .parent
+                    .map(|j| (0..rows.len()).map(|s| poses[s * n + j]).collect());
+                let (reading, reason) = self.joints[i].read(&rows, parents.as_deref(), scale);
+                self.joints[i].reading = reading;
+                let joint = bvh.skeleton.joints[i].name.clone();
+                self.position_channels.push(PositionChannels { joint, reading, reason });
+            }
+            let joint = &self.joints[i];
+            for (s, row) in rows.iter().enumerate() {
+                poses[s * n + i] = joint.pose(row, joint.parent.map(|j| poses[s * n + j]));
+            }
+        }
+    }
+}
+
+/// Frame 0 and up to [`MAX_VOTERS`] − 1 more, evenly spread to the last frame.
+fn sample_frames(num_frames: usize) -> Vec<usize> {
+    if num_frames <= MAX_VOTERS {
+        return (0..num_frames).collect();
+    }
+    (0..MAX_VOTERS).map(|k| k * (num_frames - 1) / (MAX_VOTERS - 1)).collect()
+}
+
+/// Mean length of the non-zero non-root OFFSETs (1 when there are none).
+fn mean_bone_length(joints: &[JointPlan]) -> f64 {
+    let lengths: Vec<f64> = joints
+        .iter()
+        .filter(|j| j.parent.is_some())
+        .map(|j| norm(j.offset))
+        .filter(|&l| l > 0.0)
+        .collect();
+    if lengths.is_empty() {
+        1.0
+    } else {
+        lengths.iter().sum::<f64>() / lengths.len() as f64
+    }
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    norm([a[0] - b[0], a[1] - b[1], a[2] - b[2]])
+}
+
+impl JointPlan {
+    /// This joint's reading from the sampled `rows` (frame 0 first) and, for a non-root
+    /// joint, its parent's global pose in each of them (see [`PositionReading`]).
+    fn read(
+        &self,
+        rows: &[Row],
+        parents: Option<&[(Quat, [f64; 3])]>,
+        scale: f64,
+    ) -> (PositionReading, String) {
+        if self.repeats_offset(&rows[0].values, scale) {
+            return (PositionReading::Local, "frame 0 repeats the OFFSET".to_owned());
+        }
+        let o = self.channel_offset();
+        let all_axes = self.position_columns.iter().all(Option::is_some);
+        if let Some(parents) = parents.filter(|_| all_axes) {
+            let world = self.world_votes(rows, parents, o);
+            if 2 * world > rows.len() {
+                let why = format!(
+                    "at the world position parent + OFFSET predicts in {world} of {} frames",
+                    rows.len()
+                );
+                return (PositionReading::World, why);
+            }
+        }
+        self.local_or_added(rows, o, REPEAT_TOLERANCE * norm(self.offset).max(scale))
+    }
+
+    /// The OFFSET on the axes with a position channel (0 elsewhere, like [`Self::channels`]).
+    fn channel_offset(&self) -> [f64; 3] {
+        std::array::from_fn(|k| self.position_columns[k].map_or(0.0, |_| self.offset[k]))
+    }
+
+    /// Whether the channel values of a frame repeat the OFFSET ([`REPEAT_TOLERANCE`]).
+    fn repeats_offset(&self, values: &[f64], scale: f64) -> bool {
+        let tolerance = REPEAT_TOLERANCE * norm(self.offset).max(scale);
+        distance(self.channels(values), self.channel_offset()) <= tolerance
+    }
+
+    /// How many of the frames have the channels [`WORLD_MARGIN`] times nearer the world
+    /// position the parent's pose and OFFSET predict than either local reading.
+    fn world_votes(&self, rows: &[Row], parents: &[(Quat, [f64; 3])], o: [f64; 3]) -> usize {
+        let votes = rows.iter().zip(parents).filter(|(row, (pq, pp))| {
+            let c = self.channels(&row.values);
+            let r = math::quat_rotate(pq, self.offset);
+            let predicted = [r[0] + pp[0], r[1] + pp[1], r[2] + pp[2]];
+            WORLD_MARGIN * distance(c, predicted) < distance(c, o).min(norm(c))
+        });
+        votes.count()
+    }
+
+    /// Local or Added, decided on the one axis that tells them apart best: the channel whose
+    /// spread over the clip (median absolute deviation) is smallest for the size of its
+    /// OFFSET component (a root's height, not the floor plan it walks). Its median value
+    /// nearer that component than zero is `Local`.
+    fn local_or_added(
+        &self,
+        rows: &[Row],
+        o: [f64; 3],
+        tolerance: f64,
+    ) -> (PositionReading, String) {
+        let mut best: Option<(f64, usize, f64)> = None; // (score, axis, median)
+        for (k, column) in self.position_columns.iter().enumerate() {
+            let Some(column) = *column else { continue };
+            if o[k] == 0.0 {
+                continue;
+            }
+            let values: Vec<f64> = rows.iter().map(|row| row.values[column]).collect();
+            let middle = median(values.clone());
+            let spread = median(values.iter().map(|v| (v - middle).abs()).collect());
+            let score = o[k].abs() / spread.max(tolerance * 1e-6);
+            if best.is_none_or(|(s, _, _)| score > s) {
+                best = Some((score, k, middle));
+            }
+        }
+        let Some((_, k, m)) = best else {
+            let why = "the OFFSET is zero along the channels: both readings agree".to_owned();
+            return (PositionReading::Local, why);
+        };
+        let axis = ["X", "Y", "Z"][k];
+        let (o, m) = (o[k], m);
+        if (m - o).abs() <= m.abs() {
+            let why = format!("{axis} median {m:.4} is nearer the OFFSET's {o:.4} than 0");
+            (PositionReading::Local, why)
+        } else {
+            let why = format!("{axis} median {m:.4} is nearer 0 than the OFFSET's {o:.4}");
+            (PositionReading::Added, why)
+        }
+    }
+}
+
+/// The median (upper middle value for an even count) of finite values.
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(0.0)
 }
 
 fn compile_joint(
@@ -143,6 +398,7 @@ fn compile_joint(
         parent,
         offset: joint.offset,
         position_columns: [None; 3],
+        reading: PositionReading::Local,
         rotations: Vec::new(),
     };
     if joint.kind == JointKind::End {
@@ -153,6 +409,8 @@ fn compile_joint(
         match *channel {
             Channel::Position(axis) => plan.position_columns[axis_index(axis)] = Some(column),
             Channel::Rotation(axis) => plan.rotations.push((axis, column)),
+            // Kept by the parser (it warns); not applied: a scaled frame is no rigid pose.
+            Channel::Scale(_) => {}
         }
     }
     Ok(plan)

@@ -8,9 +8,9 @@
 //!
 //! The numbers follow GMR's LAFAN1 loader operation by operation (`forward`, `math`): local
 //! `q = q(c₁) ⊗ (q(c₂) ⊗ q(c₃))` in each joint's channel order, position channels replace
-//! OFFSET, `q = q_parent ⊗ q_local`, `p = q_parent · p_local + p_parent`; world
-//! `p' = (x, −z, y) / 100` and `q' = q_x90 ⊗ q` for a Y-up centimetre file. Where we differ on
-//! purpose:
+//! OFFSET (unless the numbers say otherwise: [`PositionReading`]), `q = q_parent ⊗ q_local`,
+//! `p = q_parent · p_local + p_parent`; world `p' = (x, −z, y) / 100` and `q' = q_x90 ⊗ q`
+//! for a Y-up centimetre file. Where we differ on purpose:
 //! - End Sites are bodies too (`<Parent>_End`);
 //! - orientations are made continuous on the world quaternions (GMR does it on the local
 //!   ones: same rotations, possibly opposite signs; compare up to sign);
@@ -34,6 +34,7 @@ mod size;
 mod trig;
 
 pub use error::Error;
+pub use forward::{PositionChannels, PositionReading};
 pub use motion::HumanMotion;
 pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
 
@@ -56,6 +57,8 @@ pub struct FkReport {
     pub height_source: String,
     /// Lowest foot point over the clip: world z in metres (0 for a clip on the floor).
     pub ground: f64,
+    /// How each joint with position channels was read, in joint order ([`PositionReading`]).
+    pub position_channels: Vec<PositionChannels>,
 }
 
 /// Forward kinematics of every frame of `bvh`, converted to our world (see [`FkOptions`]).
@@ -87,8 +90,15 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
         Some(h) => (h, "given".to_owned()),
         None => (stature.height, stature.source),
     };
-    let report =
-        FkReport { metres_per_unit, unit_reason, height, height_source, ground: stature.ground };
+    let position_channels = plan.position_channels().to_vec();
+    let report = FkReport {
+        metres_per_unit,
+        unit_reason,
+        height,
+        height_source,
+        ground: stature.ground,
+        position_channels,
+    };
     Ok((motion, report))
 }
 
@@ -297,35 +307,42 @@ mod tests {
             Channel::Rotation(Axis::X) => Vector3::x_axis(),
             Channel::Rotation(Axis::Y) => Vector3::y_axis(),
             Channel::Rotation(Axis::Z) => Vector3::z_axis(),
-            Channel::Position(_) => return Matrix3::identity(),
+            Channel::Position(_) | Channel::Scale(_) => return Matrix3::identity(),
         };
         Rotation3::from_axis_angle(&axis, degrees.to_radians()).into_inner()
     }
 
-    /// Independent FK: rotation matrices chained parent to child, world = scale · R_axes.
+    /// Independent FK: rotation matrices chained parent to child, world = scale · R_axes;
+    /// position channels read as `report` says ([`PositionReading`]).
     fn matrix_chain(
         bvh: &Bvh,
         frame: usize,
         axes: Matrix3<f64>,
-        scale: f64,
+        report: &FkReport,
     ) -> Vec<(Vector3<f64>, Matrix3<f64>)> {
         let row = bvh.motion.frame(frame);
         let mut global: Vec<(Vector3<f64>, Matrix3<f64>)> = Vec::new();
         for joint in &bvh.skeleton.joints {
+            let read = report.position_channels.iter().find(|r| r.joint == joint.name);
+            let reading = read.map_or(PositionReading::Local, |r| r.reading);
             let mut p = Vector3::from(joint.offset);
             let mut r = Matrix3::identity();
             for (k, &channel) in joint.channels.iter().enumerate() {
                 let value = row[joint.first_channel + k];
-                match channel {
-                    Channel::Position(a) => p[a as usize] = value,
-                    Channel::Rotation(_) => r *= axis_matrix(channel, value),
+                match (channel, reading) {
+                    (Channel::Position(a), PositionReading::Added) => p[a as usize] += value,
+                    (Channel::Position(a), _) => p[a as usize] = value,
+                    (Channel::Rotation(_), _) => r *= axis_matrix(channel, value),
+                    (Channel::Scale(_), _) => {}
                 }
             }
             global.push(match joint.parent {
                 None => (p, r),
+                Some(JointId(i)) if reading == PositionReading::World => (p, global[i].1 * r),
                 Some(JointId(i)) => (global[i].1 * p + global[i].0, global[i].1 * r),
             });
         }
+        let scale = report.metres_per_unit;
         global.into_iter().map(|(p, r)| (axes * p * scale, axes * r)).collect()
     }
 
@@ -349,12 +366,8 @@ mod tests {
             let (motion, report) = human_motion(&bvh, &options).unwrap();
             assert_eq!(motion.num_bodies(), bvh.skeleton.joints.len());
             for frame in 0..motion.num_frames {
-                let expected = matrix_chain(
-                    &bvh,
-                    frame,
-                    options.axes.world_from_file_matrix(),
-                    report.metres_per_unit,
-                );
+                let expected =
+                    matrix_chain(&bvh, frame, options.axes.world_from_file_matrix(), &report);
                 for (body, (p, r)) in expected.iter().enumerate() {
                     let q = motion.orientation(frame, body);
                     assert!(

@@ -1,21 +1,31 @@
 //! Golden pairs: `tests/data/bad_*.bvh` and their expected errors in `tests/data/errors.txt`
-//! (`<file>: <line>:<column>: <message>`, one line per case), and the accepted fixtures.
-//! `BVH_BLESS=1 cargo test -p bvh` rewrites `errors.txt` from the current messages.
+//! (`<file>: <line>:<column>: <message>`, one line per case); `tests/data/quirk_*.bvh`, one
+//! real exporter's quirk each, and their expected dumps (summary, warnings, values) in
+//! `quirk_*.txt`; and the accepted fixtures. `BVH_BLESS=1 cargo test -p bvh` rewrites
+//! `errors.txt` and the dumps from the current output.
 
 use std::path::Path;
 
-use bvh::{Axis, Channel, Error, JointKind};
+use bvh::{Axis, Channel, Error, JointKind, Warning};
 
 use crate::{assert_round_trip, fixture_dir};
 
-fn bad_cases() -> Vec<String> {
+fn cases(prefix: &str) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(fixture_dir())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with("bad_") && n.ends_with(".bvh"))
+        .filter(|n| n.starts_with(prefix) && n.ends_with(".bvh"))
         .collect();
     names.sort();
     names
+}
+
+fn bad_cases() -> Vec<String> {
+    cases("bad_")
+}
+
+fn blessing() -> bool {
+    std::env::var_os("BVH_BLESS").is_some()
 }
 
 #[test]
@@ -29,7 +39,7 @@ fn every_bad_fixture_gives_its_expected_error() {
         })
         .collect();
     let expected_path = dir.join("errors.txt");
-    if std::env::var_os("BVH_BLESS").is_some() {
+    if blessing() {
         std::fs::write(&expected_path, actual.join("\n") + "\n").unwrap();
     }
     let expected = std::fs::read_to_string(&expected_path).unwrap();
@@ -61,12 +71,95 @@ fn every_error_kind_has_a_case_and_a_position() {
         "NotANumber",
         "NonFinite",
         "FrameLength",
-        "TooFewFrames",
-        "TooManyFrames",
         "Invalid",
     ] {
         assert!(kinds.contains(kind), "no bad_*.bvh case for Error::{kind}: {kinds:?}");
     }
+}
+
+/// What a quirk fixture must read as: the summary, the warnings, every OFFSET and every
+/// motion value (`{:?}`, the shortest text that reads back to the same `f64`).
+fn dump(name: &str, bvh: &bvh::Bvh, warnings: &[Warning]) -> String {
+    let mut out = bvh::Summary::new(bvh, name).to_string();
+    out.push_str("offsets:\n");
+    for j in &bvh.skeleton.joints {
+        let [x, y, z] = j.offset;
+        out.push_str(&format!("  `{}`: {x:?} {y:?} {z:?}\n", j.name));
+    }
+    out.push_str("warnings:\n");
+    for w in warnings {
+        out.push_str(&format!("  {w}\n"));
+    }
+    out.push_str("motion:\n");
+    for f in 0..bvh.motion.num_frames {
+        let row: Vec<String> = bvh.motion.frame(f).iter().map(|v| format!("{v:?}")).collect();
+        out.push_str(&format!("  {}\n", row.join(" ")));
+    }
+    out
+}
+
+#[test]
+fn every_quirk_fixture_reads_as_its_expected_dump() {
+    let dir = fixture_dir();
+    let names = cases("quirk_");
+    for name in &names {
+        let path = dir.join(name);
+        let (bvh, warnings) = bvh::from_path_with_warnings(&path).unwrap_or_else(|e| panic!("{e}"));
+        let actual = dump(name, &bvh, &warnings);
+        let expected_path = path.with_extension("txt");
+        if blessing() {
+            std::fs::write(&expected_path, &actual).unwrap();
+        }
+        let expected = std::fs::read_to_string(&expected_path)
+            .unwrap_or_else(|e| panic!("{}: {e}", expected_path.display()));
+        assert_eq!(actual, expected, "{name}");
+        assert_eq!(bvh::parse(&std::fs::read(&path).unwrap()).unwrap(), bvh, "{name}");
+        assert_round_trip(&bvh, name);
+        // Written back, a file says what it holds: only the scale warning can remain.
+        let mut text = Vec::new();
+        bvh::write(&bvh, &mut text).unwrap();
+        let (_, again) = bvh::parse_with_warnings(&text).unwrap();
+        assert!(again.iter().all(|w| matches!(w, Warning::ScaleChannels { .. })), "{again:?}");
+    }
+    assert!(names.len() >= 10, "{names:?}");
+}
+
+#[test]
+fn frame_count_disagreements_warn_and_keep_the_rows() {
+    let dir = fixture_dir();
+    for (name, declared, rows) in [
+        ("quirk_frames_one_more_than_rows.bvh", 3, 2),
+        ("quirk_frames_one_less_than_rows.bvh", 1, 2),
+    ] {
+        let (bvh, warnings) = bvh::from_path_with_warnings(&dir.join(name)).unwrap();
+        assert_eq!(bvh.motion.num_frames, rows, "{name}");
+        assert_eq!(bvh.motion.values.len(), rows * 9, "{name}");
+        assert_eq!(bvh.motion.frame(1)[1], 91.0, "{name}");
+        let pos = bvh::Pos { line: 17, column: 9 };
+        assert_eq!(warnings, [Warning::FrameCount { pos, declared, found: rows }], "{name}");
+        assert_eq!(warnings[0].position(), pos);
+    }
+}
+
+#[test]
+fn scale_channels_are_kept_and_reported_with_their_range() {
+    let (bvh, warnings) =
+        bvh::from_path_with_warnings(&fixture_dir().join("quirk_scale_channels.bvh")).unwrap();
+    let spine = &bvh.skeleton.joints[1];
+    assert_eq!(spine.channels[3..], [Axis::X, Axis::Y, Axis::Z].map(Channel::Scale));
+    assert_eq!(bvh.motion.frame(1)[13..], [1.25, 0.98]);
+    let ranges: Vec<(&str, f64, f64, usize)> = warnings
+        .iter()
+        .map(|w| match w {
+            Warning::ScaleChannels { joint, min, max, pos } => {
+                (joint.as_str(), *min, *max, pos.line)
+            }
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(ranges, [("Hips", 1.0, 1.0, 5), ("Spine", 0.98, 1.25, 9)]);
+    assert_eq!(Channel::from_name("Yscale"), Some(Channel::Scale(Axis::Y)));
+    assert_eq!(Channel::Scale(Axis::Z).name(), "Zscale");
 }
 
 #[test]

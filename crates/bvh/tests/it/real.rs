@@ -163,10 +163,11 @@ fn cmu_mixes_rotation_orders_and_mixamo_keeps_colons() {
 }
 
 #[test]
-fn every_shared_file_round_trips_exactly() {
+fn every_shared_file_round_trips_exactly_and_without_warnings() {
     let Some(files) = shared_bvh_files() else { return };
     for path in &files {
-        let bvh = bvh::from_path(path).unwrap_or_else(|e| panic!("{e}"));
+        let (bvh, warnings) = bvh::from_path_with_warnings(path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(warnings.is_empty(), "{}: {warnings:?}", path.display());
         assert_round_trip(&bvh, &path.display().to_string());
     }
 }
