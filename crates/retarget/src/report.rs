@@ -595,6 +595,8 @@ mod tests {
             pos: Vector3::zeros(),
             quat: nalgebra::UnitQuaternion::identity(),
             mesh: None,
+            contype: 1,
+            conaffinity: 1,
         };
         let id = nalgebra::Matrix3::identity();
         assert_eq!(lowest_offset(&geom, &id), Some(0.3));
