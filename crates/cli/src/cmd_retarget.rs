@@ -22,7 +22,8 @@ pub struct MainArgs {
     /// with `marker_bodies`, e.g. configs/c3d_plugingait_to_unitree_g1.json.
     #[arg(long, value_name = "FILE", conflicts_with = "bvh", requires = "config")]
     pub c3d: Option<PathBuf>,
-    /// Robot: a shipped name (see `retarget robots`) or a path to an MJCF file.
+    /// Robot: a shipped name (see `retarget robots`) or a path to an MJCF (.xml) or URDF
+    /// (.urdf) file.
     #[arg(long)]
     pub robot: Option<String>,
     /// Output file; format from the extension (.npz, .csv, .pkl, .json). Default:
@@ -30,7 +31,7 @@ pub struct MainArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// IK config (GMR schema). Default: the shipped LAFAN1 config of a shipped robot;
-    /// required with an MJCF path as --robot.
+    /// required with a model path as --robot.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Subject height in metres (default: estimated from the skeleton; GMR assumes 1.75).

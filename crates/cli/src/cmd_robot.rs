@@ -11,7 +11,7 @@ use crate::shipped;
 
 #[derive(Subcommand, Debug)]
 pub enum RobotCommand {
-    /// Print joints, ranges and bodies of a robot (shipped name or MJCF path).
+    /// Print joints, ranges and bodies of a robot (shipped name, MJCF or URDF path).
     Info { robot: String },
     /// Compare our kinematics with MuJoCo's at random configurations (needs the `mujoco`
     /// feature): model structure, body poses and body Jacobians.
@@ -87,6 +87,11 @@ fn info(robot: &str) -> anyhow::Result<ExitCode> {
                     hi.to_degrees()
                 )
             }
+        };
+        let unit = if j.kind == JointType::Slide { "m/s" } else { "rad/s" };
+        let range = match j.velocity_limit {
+            Some(v) => format!("{range}  speed {v} {unit}"),
+            None => range,
         };
         let name = if j.name.is_empty() { "(unnamed)" } else { &j.name };
         writeln!(

@@ -40,7 +40,7 @@ enum Command {
     C3d(cmd_c3d::C3dCommand),
     /// List the robots and configs shipped with the tool.
     Robots,
-    /// Inspect one robot model (shipped name or MJCF path).
+    /// Inspect one robot model (shipped name, MJCF or URDF path).
     #[command(subcommand)]
     Robot(cmd_robot::RobotCommand),
     /// Convert a whole directory tree of clips, in parallel and resumable.

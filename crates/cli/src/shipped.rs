@@ -1,5 +1,5 @@
 //! The robot models compiled into the binary (`robots/<key>/<key>.xml`, mesh-free MJCF), and
-//! how a `--robot` argument (shipped key or MJCF path) becomes an [`mjcf::Model`].
+//! how a `--robot` argument (shipped key, MJCF or URDF path) becomes an [`mjcf::Model`].
 
 use std::path::Path;
 
@@ -25,8 +25,9 @@ pub fn shipped_keys() -> impl Iterator<Item = &'static str> {
     SHIPPED.iter().map(|(k, _)| *k)
 }
 
-/// A shipped robot by key, else the MJCF file at that path. An unknown name that is not a
-/// file errors with the list of shipped keys.
+/// A shipped robot by key, else the model file at that path (`.xml` MJCF or `.urdf` URDF, by
+/// [`mjcf::Model::from_path`]). An unknown name that is not a file errors with the list of
+/// shipped keys.
 pub fn robot_model(name_or_path: &str) -> anyhow::Result<mjcf::Model> {
     if let Some(xml) = shipped_xml(name_or_path) {
         return mjcf::Model::from_xml_str(xml, None).with_context(|| {
@@ -37,11 +38,11 @@ pub fn robot_model(name_or_path: &str) -> anyhow::Result<mjcf::Model> {
     let looks_like_path =
         path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR);
     if path.is_file() || looks_like_path {
-        return Ok(mjcf::Model::from_file(path)?);
+        return Ok(mjcf::Model::from_path(path)?);
     }
     let keys: Vec<&str> = shipped_keys().collect();
     anyhow::bail!(
-        "unknown robot \"{name_or_path}\": not a shipped robot ({}) and not an MJCF file",
+        "unknown robot \"{name_or_path}\": not a shipped robot ({}) and not an MJCF or URDF file",
         keys.join(", ")
     )
 }

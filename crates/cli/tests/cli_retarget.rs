@@ -142,3 +142,44 @@ fn fps_resamples_the_output_and_unknown_robots_are_errors() {
     let out = retarget(&["--bvh", "x.bvh"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// The G1 URDF (shared reference) as `--robot`, with the G1's LAFAN1 config: its body names
+/// are the MJCF G1's (the config names only links with joints, none of the merged ones), and
+/// the motion agrees with the one on our MJCF G1 wherever the URDF's wider joint ranges do not
+/// change the solution.
+#[test]
+fn urdf_robot_retargets_with_the_g1_config() {
+    let dir = temp_dir("urdf");
+    let Some(bvh) = short_walk(&dir, 40) else { return };
+    let Some(urdf) =
+        shared::shared_file("reference/robots/unitree_g1/g1_custom_collision_29dof.urdf")
+    else {
+        return;
+    };
+    let config =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+    let mut outputs = Vec::new();
+    for (robot, name) in [(urdf.to_str().unwrap(), "urdf.npz"), ("unitree_g1", "mjcf.npz")] {
+        let path = dir.join(name);
+        let out = retarget(&[
+            "--bvh",
+            bvh.to_str().unwrap(),
+            "--robot",
+            robot,
+            "--config",
+            config.to_str().unwrap(),
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{robot}: {}", text(&out).1);
+        outputs.push(retarget::writers::read_motion_npz(&path).unwrap());
+    }
+    let (urdf_motion, mjcf_motion) = (&outputs[0], &outputs[1]);
+    assert_eq!(urdf_motion.nq, 36);
+    assert_eq!(urdf_motion.joint_names, mjcf_motion.joint_names);
+    let mut diffs: Vec<f64> =
+        urdf_motion.qpos.iter().zip(&mjcf_motion.qpos).map(|(a, b)| (a - b).abs()).collect();
+    diffs.sort_by(f64::total_cmp);
+    let median = diffs[diffs.len() / 2];
+    assert!(median < 1e-6, "median |qpos difference| {median:e}");
+}

@@ -1,5 +1,8 @@
 //! `retarget robots`, `retarget robot info` and (feature `mujoco`) `retarget robot check`.
 
+#[path = "../../../tests/support/shared.rs"]
+mod shared;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -93,6 +96,28 @@ fn robot_info_prints_joints_and_bodies() {
     }
 }
 
+/// `robot info` on the shared G1 URDF: a free root and 29 hinges with the file's ranges and
+/// speed limits.
+#[test]
+fn robot_info_reads_a_urdf() {
+    let Some(path) =
+        shared::shared_file("reference/robots/unitree_g1/g1_custom_collision_29dof.urdf")
+    else {
+        return;
+    };
+    let out = retarget(&["robot", "info", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = stdout(&out);
+    assert!(text.contains("nq 36  nv 35  joint dofs 29  bodies 31"), "{text}");
+    let hinges: Vec<&str> =
+        text.lines().filter(|l| l.split_whitespace().nth(2) == Some("hinge")).collect();
+    assert_eq!(hinges.len(), 29, "{text}");
+    assert!(hinges.iter().all(|l| l.contains("] rad") && l.contains("rad/s")), "{text}");
+    let knee = hinges.iter().find(|l| l.contains(" left_knee_joint ")).expect("knee");
+    assert!(knee.contains("[-0.0873, 2.8798] rad") && knee.contains("speed 20 rad/s"), "{knee}");
+    assert!(text.contains("pelvis_free_joint                free"), "{text}");
+}
+
 #[test]
 fn unknown_robot_fails_listing_shipped_keys() {
     let out = retarget(&["robot", "info", "no_such_robot"]);
@@ -123,6 +148,8 @@ fn robot_check_agrees_with_mujoco() {
     let path = features_xml();
     let mut targets: Vec<String> = repo_robot_keys();
     targets.push(path.to_str().unwrap().to_owned());
+    let urdf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mjcf/tests/data/urdf/features.urdf");
+    targets.push(urdf.to_str().unwrap().to_owned());
     for target in targets {
         let out = retarget(&["robot", "check", &target, "--configs", "20"]);
         let text = stdout(&out);

@@ -9,6 +9,11 @@
 //! `mj_jac`/`mj_jacBody` and `mj_integratePos`; the `mujoco` feature adds
 //! [`mujoco_check`], which compares everything with MuJoCo 3.17.0 itself.
 //!
+//! URDF is read into the same [`Model`] ([`Model::from_urdf_file`], [`Model::from_path`]) with
+//! the semantics of MuJoCo's URDF import (static links fused into their parent, visuals
+//! dropped, `rpy` as fixed-axis roll-pitch-yaw), plus a free root joint unless
+//! [`UrdfBase::Fixed`] is asked for; `<limit velocity>` becomes [`Joint::velocity_limit`].
+//!
 //! ```
 //! let xml = r#"<mujoco><worldbody><body name="a" pos="0 0 1">
 //!   <joint name="j" axis="0 1 0" range="-90 90"/><geom size="0.1"/>
@@ -31,6 +36,7 @@ pub mod mujoco_check;
 mod sample;
 mod source;
 mod syntax;
+mod urdf;
 
 use std::path::Path;
 
@@ -39,6 +45,7 @@ pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;
 pub use model::{Body, Geom, GeomType, Joint, JointType, Model, Site};
+pub use urdf::{UrdfBase, UrdfOptions};
 
 impl Model {
     /// Reads and compiles an MJCF file; `<include>` paths are relative to its directory.
@@ -53,6 +60,41 @@ impl Model {
     /// `None`). Errors name the file `<string>`.
     pub fn from_xml_str(xml: &str, base_dir: Option<&Path>) -> Result<Model, Error> {
         Self::build("<string>".to_owned(), xml.to_owned(), base_dir)
+    }
+
+    /// Reads a URDF file with MuJoCo's URDF semantics (see [`UrdfOptions`] for the root and
+    /// static links). Errors name the file and `line:column`.
+    pub fn from_urdf_file(path: &Path, options: UrdfOptions) -> Result<Model, Error> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+        Self::build_urdf(path.display().to_string(), text, options)
+    }
+
+    /// Compiles URDF text. Errors name the file `<string>`.
+    pub fn from_urdf_str(urdf: &str, options: UrdfOptions) -> Result<Model, Error> {
+        Self::build_urdf("<string>".to_owned(), urdf.to_owned(), options)
+    }
+
+    /// Reads a robot model by its extension: `.xml` as MJCF ([`Model::from_file`]), `.urdf` as
+    /// URDF with the default options (a free root: [`Model::from_urdf_file`]).
+    pub fn from_path(path: &Path) -> Result<Model, Error> {
+        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match extension.as_deref() {
+            Some("xml") => Self::from_file(path),
+            Some("urdf") => Self::from_urdf_file(path, UrdfOptions::default()),
+            _ => Err(Error::Model {
+                file: path.display().to_string(),
+                message: "unknown robot model format: expected a .xml (MJCF) or .urdf (URDF) file"
+                    .to_owned(),
+            }),
+        }
+    }
+
+    fn build_urdf(name: String, text: String, options: UrdfOptions) -> Result<Model, Error> {
+        let mut sources = source::Sources::default();
+        sources.add(name, text.clone());
+        let tree = urdf::parse(&sources, &text)?;
+        urdf::build(&tree, &sources, options)
     }
 
     fn build(name: String, text: String, base_dir: Option<&Path>) -> Result<Model, Error> {

@@ -2,16 +2,23 @@
 //! compiled model (sizes, names, order, ranges, `qpos0`, body and joint frames) and, at random
 //! configurations, every body pose, every body Jacobian and every geom and site position.
 //! Shared by the parity tests and `retarget robot check`.
+//!
+//! A URDF is compiled by MuJoCo's own URDF import (`mj_loadXML` reads `<robot>` files). MuJoCo
+//! adds no free joint there, so a model read with [`UrdfBase::Fixed`] is compared with that
+//! compile as it is; for [`UrdfBase::Floating`] the free joint is added on MuJoCo's side too,
+//! through its model-editing API on the parsed spec, the way MuJoCo itself does it when it
+//! loads a URDF as a moving body (`xml_urdf.cc`: `ROOT_free_joint` on the root link), then
+//! MuJoCo compiles it (static links fused as usual).
 
 use std::fmt;
 use std::path::Path;
 
-use mujoco_rs::prelude::{MjModel, MjtObjBase};
+use mujoco_rs::prelude::{MjModel, MjSpec, MjtJoint, MjtObjBase, SpecElement, SpecItem};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::{Data, Error, GeomType, JointType, Model};
+use crate::{Data, Error, GeomType, JointType, Model, UrdfBase, UrdfOptions};
 
 /// How many random configurations (checked in addition to `qpos0`), from which seed.
 #[derive(Debug, Clone, Copy)]
@@ -89,9 +96,41 @@ fn mujoco_error(path: &Path, message: impl fmt::Display) -> Error {
     Error::Model { file: path.display().to_string(), message: format!("mujoco: {message}") }
 }
 
-/// Loads `path` with MuJoCo and compares it with `model` (normally `Model::from_file(path)`).
+/// Loads `path` with MuJoCo and compares it with `model` (normally `Model::from_path(path)`):
+/// MJCF as it is, a `.urdf` as [`check_urdf_file`] does with the default [`UrdfOptions`].
 pub fn check_file(model: &Model, path: &Path, options: CheckOptions) -> Result<Report, Error> {
+    let is_urdf = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf"));
+    if is_urdf {
+        return check_urdf_file(model, path, UrdfOptions::default(), options);
+    }
     let mj = MjModel::from_xml(path).map_err(|e| mujoco_error(path, e))?;
+    Ok(check_loaded(model, &mj, options))
+}
+
+/// Compiles the URDF at `path` with MuJoCo as `urdf` asks (see the module documentation) and
+/// compares it with `model` (normally `Model::from_urdf_file(path, urdf)`).
+pub fn check_urdf_file(
+    model: &Model,
+    path: &Path,
+    urdf: UrdfOptions,
+    options: CheckOptions,
+) -> Result<Report, Error> {
+    let err = |e: mujoco_rs::error::MjEditError| mujoco_error(path, e);
+    let mut spec = MjSpec::from_xml(path).map_err(err)?;
+    if let Some(fuse) = urdf.fuse_static {
+        spec.compiler_mut().set_fusestatic(fuse);
+    }
+    if urdf.base == UrdfBase::Floating {
+        // The root link is the world's first child in the parsed spec; a file with a floating
+        // joint of its own keeps it and gets no second one.
+        let world = spec.world_body_mut();
+        let has_free = world.joint_iter(true).any(|j| j.type_() == MjtJoint::mjJNT_FREE);
+        if let (false, Some(root)) = (has_free, world.body_iter_mut().next()) {
+            let name = format!("{}_free_joint", root.name());
+            root.add_free_joint().set_name(&name).map_err(err)?;
+        }
+    }
+    let mj = spec.compile().map_err(err)?;
     Ok(check_loaded(model, &mj, options))
 }
 

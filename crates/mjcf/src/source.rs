@@ -19,7 +19,7 @@ pub(crate) struct Sources {
 }
 
 impl Sources {
-    fn add(&mut self, name: String, text: String) -> u32 {
+    pub(crate) fn add(&mut self, name: String, text: String) -> u32 {
         self.files.push((name, text));
         u32::try_from(self.files.len() - 1).unwrap_or(u32::MAX)
     }
