@@ -16,9 +16,18 @@
 //!   segments (Ericson, *Real-Time Collision Detection*, §5.1.9), exact to rounding;
 //! - every pair with a box, cylinder or ellipsoid goes to GJK (distance) and, when the cores
 //!   overlap, EPA (penetration depth) from `parry3d-f64` on the cores' exact support functions,
-//!   converged to a relative 5e-8 of the distance. Box and cylinder cores are polytope-like and
-//!   come out exact to that tolerance; an ellipsoid is curved everywhere, so in penetration its
-//!   depth is EPA's polytope approximation (within EPA's tolerance of the true depth).
+//!   converged to a relative 5e-8 of the distance when apart. In penetration EPA approximates
+//!   the cores' Minkowski difference by a polytope: exact for boxes, within ~1e-5 m for the
+//!   curved parts (cylinder rims, ellipsoids), as the brute-force test
+//!   `penetration_depth_is_the_minimum_translation` measures. An ellipsoid therefore has an
+//!   exact support function but an approximate penetration depth.
+//!
+//! Why these and not parry's generic `query::contact` (criterion, `benches/collision.rs`, G1,
+//! pairs closer than 5 cm at random configurations): sphere/capsule pairs take 0.23 µs in
+//! closed form against 5 µs through parry's GJK on rounded shapes (which also converges only
+//! approximately on them); capsule–box 1.3 µs on the segment core against 9 µs; box–box and
+//! cylinder pairs are parry's GJK/EPA either way (3.7 and 6 µs, mostly penetrating pairs). A
+//! whole G1 check of its 303 pairs with a 5 cm cut-off, bounding spheres first, is 44 µs.
 //!
 //! MuJoCo's `mj_geomDistance` does the same split (its primitive colliders for sphere and
 //! capsule pairs, its native GJK/EPA for the rest); `mujoco_check` (feature `mujoco`) compares
