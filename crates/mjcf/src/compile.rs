@@ -1,6 +1,7 @@
 //! Typed MJCF tree → [`Model`], following MuJoCo's compiler (`user_model.cc`, `user_objects.cc`):
 //! default classes with inheritance and `childclass`, angle units, orientation specifiers,
-//! `<frame>` composition, `autolimits`, joint addresses and `qpos0`.
+//! `<frame>` composition, `autolimits`, joint addresses and `qpos0`; the collision filter's
+//! inputs (geom `contype`/`conaffinity`, `<contact>` excludes and pairs, `filterparent`).
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -13,7 +14,7 @@ use crate::model::{Body, Geom, GeomType, Joint, JointType, Model, Site};
 use crate::source::{Pos, Sources};
 use crate::syntax::{
     AngleUnit, BodySpec, DefaultSpec, GeomAttrs, GeomSpec, Item, JointAttrs, JointSpec, Limited,
-    Mjcf, Orientation,
+    Mjcf, NameRef, Orientation,
 };
 
 /// A default class with its ancestors' attributes merged in.
@@ -71,15 +72,36 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
             jnt_pos_zero: Vec::new(),
             geom_mat: Vec::new(),
             site_mat: Vec::new(),
+            contact_excludes: Vec::new(),
+            contact_pairs: Vec::new(),
+            filter_parent: mjcf.filterparent.unwrap_or(true),
         },
     };
     let main_class = mjcf.default.class.clone();
     compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
     let mut model = compiler.model;
+    model.contact_excludes = resolve_names(&mjcf.contact.excludes, src, "body", |n| {
+        model.bodies.iter().position(|b| b.name == n)
+    })?;
+    model.contact_pairs = resolve_names(&mjcf.contact.pairs, src, "geom", |n| model.geom_id(n))?;
     model.jnt_pos_zero = model.joints.iter().map(|j| j.pos == Vector3::zeros()).collect();
     model.geom_mat = model.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
     model.site_mat = model.sites.iter().map(|s| *s.quat.to_rotation_matrix().matrix()).collect();
     Ok(model)
+}
+
+/// Ids of the named bodies or geoms of `<exclude>`/`<pair>` elements (MuJoCo rejects unknown
+/// names, and so do we).
+fn resolve_names(
+    pairs: &[[NameRef; 2]],
+    src: &Sources,
+    what: &str,
+    find: impl Fn(&str) -> Option<usize>,
+) -> Result<Vec<[usize; 2]>, Error> {
+    let id = |r: &NameRef| {
+        find(&r.name).ok_or_else(|| src.invalid(r.pos, format!("unknown {what} \"{}\"", r.name)))
+    };
+    pairs.iter().map(|[a, b]| Ok([id(a)?, id(b)?])).collect()
 }
 
 fn flatten_defaults(
@@ -131,6 +153,8 @@ fn merge_geom(own: &GeomAttrs, base: &GeomAttrs) -> GeomAttrs {
         orientation: own.orientation.or(base.orientation),
         fromto: own.fromto.or(base.fromto),
         mesh: own.mesh.clone().or_else(|| base.mesh.clone()),
+        contype: own.contype.or(base.contype),
+        conaffinity: own.conaffinity.or(base.conaffinity),
     }
 }
 
@@ -425,6 +449,8 @@ impl<'a> Compiler<'a> {
             pos: placed.pos,
             quat: placed.quat,
             mesh: attrs.mesh.filter(|_| kind == GeomType::Mesh),
+            contype: attrs.contype.unwrap_or(1),
+            conaffinity: attrs.conaffinity.unwrap_or(1),
         })
     }
 }

@@ -25,6 +25,7 @@
 //! assert!((data.xpos[1].z - 1.0).abs() < 1e-15);
 //! ```
 
+pub mod collision;
 mod compile;
 mod error;
 mod kinematics;
@@ -39,6 +40,7 @@ mod urdf;
 
 use std::path::Path;
 
+pub use collision::{geom_bounding_sphere, geom_distance, geom_lowest_point, Proximity};
 pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;

@@ -118,6 +118,11 @@ pub struct Geom {
     /// Mesh asset name of a mesh geom. Its pose is kept as written: MuJoCo additionally moves
     /// mesh geoms to the mesh's inertial frame, which needs the mesh file and is not done here.
     pub mesh: Option<String>,
+    /// MuJoCo `geom_contype`: the collision bitmask (default 1). Two geoms may collide when
+    /// `contype1 & conaffinity2` or `contype2 & conaffinity1` is non-zero.
+    pub contype: i32,
+    /// MuJoCo `geom_conaffinity` (default 1).
+    pub conaffinity: i32,
 }
 
 /// A site, placed in its body's frame.
@@ -146,6 +151,15 @@ pub struct Model {
     pub sites: Vec<Site>,
     /// Default configuration (free: body pos and quat; ball: identity; hinge, slide: `ref`).
     pub qpos0: Vec<f64>,
+    /// `<contact><exclude body1 body2>`: body pairs whose geoms never collide (body ids, as
+    /// written; MuJoCo `exclude_signature`).
+    pub contact_excludes: Vec<[usize; 2]>,
+    /// `<contact><pair geom1 geom2>`: geom pairs that always go to collision checking, whatever
+    /// the filters say (geom ids, as written; MuJoCo `pair_geom1`/`pair_geom2`).
+    pub contact_pairs: Vec<[usize; 2]>,
+    /// `<option><flag filterparent>` (default enabled): geoms of a body and of its parent do
+    /// not collide unless the parent is the world (MuJoCo `mjDSBL_FILTERPARENT` off).
+    pub filter_parent: bool,
     /// Joint of each dof.
     pub(crate) dof_joint: Vec<usize>,
     /// Previous dof on the path to the world (MuJoCo `dof_parentid`).

@@ -333,3 +333,454 @@ fn compare_kinematics(model: &Model, mj: &MjModel, options: CheckOptions, report
 fn dev3(a: &Vector3<f64>, b: &[f64; 3]) -> f64 {
     max_abs(a.as_slice(), b)
 }
+
+// ------------------------------------------------------------------------------------------
+// Collision geometry
+// ------------------------------------------------------------------------------------------
+
+/// [`check_collision`] compares distances only for pairs closer than this (m).
+pub const NEAR: f64 = 0.05;
+
+/// Deviations of one kind of distance computation from `mj_geomDistance`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DistanceDeviation {
+    /// Pair × configuration comparisons (pairs closer than [`NEAR`] by either computation).
+    pub compared: usize,
+    /// Of those, penetrating ones.
+    pub penetrating: usize,
+    /// Largest |signed distance difference| (m).
+    pub distance: f64,
+    /// Largest distance of one of our witness points from its geom's surface (m), measured
+    /// with MuJoCo's `geom_xpos`, `geom_xmat` and `geom_size`. Witness points need not be
+    /// unique (parallel faces), so this, not their difference from MuJoCo's, is what we check.
+    pub surface: f64,
+    /// Largest |witness point − MuJoCo's| (m): information only (see `surface`).
+    pub point: f64,
+    /// Largest |normal − MuJoCo's| where |distance| > 1 mm (MuJoCo's normal is
+    /// `(to − from) / distance`).
+    pub normal: f64,
+}
+
+impl DistanceDeviation {
+    fn add(
+        &mut self,
+        penetrating: bool,
+        distance: f64,
+        surface: f64,
+        point: f64,
+        normal: Option<f64>,
+    ) {
+        self.compared += 1;
+        self.penetrating += usize::from(penetrating);
+        self.distance = self.distance.max(distance);
+        self.surface = self.surface.max(surface);
+        self.point = self.point.max(point);
+        self.normal = self.normal.max(normal.unwrap_or(0.0));
+    }
+
+    fn within(&self, distance: f64, surface: f64, normal: f64) -> bool {
+        self.distance <= distance && self.surface <= surface && self.normal <= normal
+    }
+}
+
+/// Result of [`check_collision`].
+#[derive(Debug, Clone, Default)]
+pub struct CollisionReport {
+    /// Differences in the filter's inputs or in the pair list, and distances that disagree in
+    /// kind (empty when everything agrees).
+    pub mismatches: Vec<String>,
+    /// Our [`Model::collision_pairs`], and how many of them have two primitive geoms.
+    pub pairs: usize,
+    pub primitive_pairs: usize,
+    pub configs: usize,
+    /// Contacts `mj_collision` found over all configurations (each must be one of our pairs).
+    pub engine_contacts: usize,
+    /// Sphere and capsule pairs: closed forms on both sides.
+    pub closed_form: DistanceDeviation,
+    /// Pairs MuJoCo hands to its native GJK/EPA (box–box, and every pair with an ellipsoid or
+    /// a cylinder except sphere–cylinder), as do we.
+    pub gjk: DistanceDeviation,
+    /// Sphere–box, capsule–box and sphere–cylinder apart (MuJoCo's primitive colliders, our
+    /// GJK); penetrating ones are in `shallower`.
+    pub primitive: DistanceDeviation,
+    /// Penetrating pairs of the kind above where MuJoCo's depth is shallower than ours:
+    /// `mjc_CapsuleBox` reports a contact depth, not the minimum separating translation (the
+    /// unit test `penetration_depth_is_the_minimum_translation` shows ours is that minimum).
+    /// Each is checked to be no deeper in MuJoCo than in ours.
+    pub shallower: usize,
+    /// Largest deviation of a lowest point beyond what the two models' geom frames explain:
+    /// |z − (centre z − support along −z)| and the point's distance outside its geom, both
+    /// from MuJoCo's `geom_xpos`/`geom_xmat`/`geom_size`, less |Δxmat|·|size|.
+    pub max_lowest: f64,
+    /// Largest |our geom_xmat − MuJoCo's| (MuJoCo snaps a geom frame within ~1e-6 of its
+    /// body's or inertial frame onto it, `geom_sameframe`).
+    pub max_xmat: f64,
+    /// Largest |bounding radius − MuJoCo `geom_rbound`| over primitives.
+    pub max_rbound: f64,
+}
+
+/// Tolerances of [`CollisionReport::passes`].
+#[derive(Debug, Clone, Copy)]
+pub struct CollisionTolerances {
+    /// |Δ distance| (m) and |Δ normal| where both sides use closed forms or exact primitive
+    /// colliders (sphere/capsule pairs; sphere–box, capsule–box, sphere–cylinder when
+    /// separated).
+    pub exact_distance: f64,
+    pub exact_normal: f64,
+    /// |Δ distance| (m) and |Δ normal| where both sides use GJK/EPA.
+    pub gjk_distance: f64,
+    pub gjk_normal: f64,
+    /// Witness points' distance from their geoms' surfaces (m).
+    pub surface: f64,
+    /// Lowest points beyond the frame difference, bounding radii (m).
+    pub lowest: f64,
+}
+
+impl CollisionReport {
+    /// No mismatch and every deviation within `tol`.
+    #[must_use]
+    pub fn passes(&self, tol: &CollisionTolerances) -> bool {
+        self.mismatches.is_empty()
+            && self.closed_form.within(tol.exact_distance, tol.surface, tol.exact_normal)
+            && self.primitive.within(tol.exact_distance, tol.surface, tol.exact_normal)
+            && self.gjk.within(tol.gjk_distance, tol.surface, tol.gjk_normal)
+            && self.max_lowest <= tol.lowest
+            && self.max_rbound <= tol.lowest
+    }
+}
+
+impl fmt::Display for CollisionReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let status = if self.mismatches.is_empty() { "identical" } else { "MISMATCH" };
+        writeln!(f, "collision filter inputs and pairs: {status} ({} pairs)", self.pairs)?;
+        for m in &self.mismatches {
+            writeln!(f, "  {m}")?;
+        }
+        writeln!(
+            f,
+            "over {} configurations: {} mj_collision contacts, all on our pair list",
+            self.configs, self.engine_contacts
+        )?;
+        for (what, d) in [
+            ("sphere/capsule", self.closed_form),
+            ("gjk/epa", self.gjk),
+            ("sphere,capsule-box/cyl", self.primitive),
+        ] {
+            writeln!(
+                f,
+                "  {what:<22} {:>5} < {NEAR} m ({:>4} pen.): |Δdist| {:.1e}, off surface {:.1e}, |Δnormal| {:.1e}, |Δpoint| {:.1e}",
+                d.compared, d.penetrating, d.distance, d.surface, d.normal, d.point
+            )?;
+        }
+        writeln!(f, "  penetrating, shallower in mjc_CapsuleBox/SphereBox: {}", self.shallower)?;
+        write!(
+            f,
+            "  lowest points {:.1e} m (geom frames differ by up to {:.1e}), bounding radii {:.1e} m",
+            self.max_lowest, self.max_xmat, self.max_rbound
+        )
+    }
+}
+
+fn geom_type_of(code: u32) -> GeomType {
+    [
+        GeomType::Plane,
+        GeomType::Hfield,
+        GeomType::Sphere,
+        GeomType::Capsule,
+        GeomType::Ellipsoid,
+        GeomType::Cylinder,
+        GeomType::Box,
+        GeomType::Mesh,
+    ]
+    .get(code as usize)
+    .copied()
+    .unwrap_or(GeomType::Sdf)
+}
+
+/// MuJoCo's collision filter (see [`Model::collision_pairs`] for the rule and its source)
+/// applied to MuJoCo's own compiled arrays: `geom_type`, `geom_bodyid`, `geom_contype`,
+/// `geom_conaffinity`, `body_weldid`, `body_parentid`, `exclude_signature`, `pair_geom1/2` and
+/// `opt.disableflags`.
+fn mujoco_pairs(mj: &MjModel) -> Vec<[usize; 2]> {
+    let kinds: Vec<GeomType> = mj.geom_type().iter().map(|t| geom_type_of(*t as u32)).collect();
+    let (body, contype, conaff) = (mj.geom_bodyid(), mj.geom_contype(), mj.geom_conaffinity());
+    let (weld, parent) = (mj.body_weldid(), mj.body_parentid());
+    let filterparent = mj.ffi().opt.disableflags
+        & mujoco_rs::mujoco_c::mjtDisableBit::mjDSBL_FILTERPARENT as i32
+        == 0;
+    let excluded: std::collections::BTreeSet<[usize; 2]> = mj
+        .exclude_signature()
+        .iter()
+        .map(|s| {
+            let (a, b) = ((s >> 16) as usize, (s & 0xFFFF) as usize);
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    let flat = |t: GeomType| matches!(t, GeomType::Plane | GeomType::Hfield);
+    let mut pairs = std::collections::BTreeSet::new();
+    let n = kinds.len();
+    for g1 in 0..n {
+        for g2 in g1 + 1..n {
+            let (b1, b2) = (body[g1] as usize, body[g2] as usize);
+            let (w1, w2) = (weld[b1], weld[b2]);
+            let (pw1, pw2) =
+                (weld[parent[w1 as usize] as usize], weld[parent[w2 as usize] as usize]);
+            let welded = w1 == w2;
+            let related = filterparent && w1 != 0 && w2 != 0 && (w1 == pw2 || w2 == pw1);
+            let bitmask = contype[g1] & conaff[g2] != 0 || contype[g2] & conaff[g1] != 0;
+            let no_function = flat(kinds[g1]) && flat(kinds[g2]);
+            let exclude = excluded.contains(&[b1.min(b2), b1.max(b2)]);
+            if bitmask && !(welded || related || no_function || exclude) {
+                pairs.insert([g1, g2]);
+            }
+        }
+    }
+    for (a, b) in mj.pair_geom1().iter().zip(mj.pair_geom2()) {
+        let (a, b) = (*a as usize, *b as usize);
+        if a != b && !(flat(kinds[a]) && flat(kinds[b])) {
+            pairs.insert([a.min(b), a.max(b)]);
+        }
+    }
+    pairs.into_iter().collect()
+}
+
+fn compare_filter_inputs(model: &Model, mj: &MjModel, report: &mut CollisionReport) {
+    if model.geoms.len() != mj.ffi().ngeom as usize {
+        report.mismatches.push(format!(
+            "ngeom: ours {}, mujoco {}",
+            model.geoms.len(),
+            mj.ffi().ngeom
+        ));
+        return;
+    }
+    let (contype, conaff, rbound) = (mj.geom_contype(), mj.geom_conaffinity(), mj.geom_rbound());
+    for (g, geom) in model.geoms.iter().enumerate() {
+        if geom.contype != contype[g] || geom.conaffinity != conaff[g] {
+            report.mismatches.push(format!(
+                "geom {g} {:?}: contype/conaffinity ours {}/{}, mujoco {}/{}",
+                geom.name, geom.contype, geom.conaffinity, contype[g], conaff[g]
+            ));
+        }
+        if let Some(r) = geom.bounding_radius() {
+            report.max_rbound = report.max_rbound.max((r - rbound[g]).abs());
+        }
+    }
+    let weld = model.body_weld_ids();
+    for (b, (ours, theirs)) in weld.iter().zip(mj.body_weldid()).enumerate() {
+        if *ours != *theirs as usize {
+            report.mismatches.push(format!("body {b}: weld id ours {ours}, mujoco {theirs}"));
+        }
+    }
+    let (ours, theirs) = (model.collision_pairs(), mujoco_pairs(mj));
+    let name = |g: usize| name_of(mj, MjtObjBase::mjOBJ_GEOM, g);
+    for p in ours.iter().filter(|p| !theirs.contains(p)) {
+        report.mismatches.push(format!("pair {p:?} ({}, {}) only ours", name(p[0]), name(p[1])));
+    }
+    for p in theirs.iter().filter(|p| !ours.contains(p)) {
+        report.mismatches.push(format!(
+            "pair {p:?} ({}, {}) only mujoco's",
+            name(p[0]),
+            name(p[1])
+        ));
+    }
+}
+
+/// Our collision geometry against MuJoCo 3.17.0 on `path` (the file `model` was read from):
+/// - the filter's inputs (`contype`, `conaffinity`, weld ids) and [`Model::collision_pairs`]
+///   against MuJoCo's filtering rule applied to MuJoCo's compiled arrays, and, at every
+///   configuration, every contact `mj_collision` finds is on our list;
+/// - at `qpos0` and `options.configs` random configurations, [`crate::geom_distance`] against
+///   `mj_geomDistance` for every primitive pair closer than [`NEAR`] (signed distance, witness
+///   points on their surfaces, normal), on MuJoCo's geom poses;
+/// - [`crate::geom_lowest_point`] of every primitive against the support function along −z
+///   computed from MuJoCo's `geom_xpos`, `geom_xmat`, `geom_size`, and the point lying on the
+///   geom; [`crate::Geom::bounding_radius`] against `geom_rbound`.
+pub fn check_collision(
+    model: &Model,
+    path: &Path,
+    options: CheckOptions,
+) -> Result<CollisionReport, Error> {
+    let mj = MjModel::from_xml(path).map_err(|e| mujoco_error(path, e))?;
+    let mut report = CollisionReport { configs: options.configs, ..CollisionReport::default() };
+    compare_filter_inputs(model, &mj, &mut report);
+    if !report.mismatches.is_empty() {
+        return Ok(report);
+    }
+    let pairs = model.collision_pairs();
+    let primitive: Vec<[usize; 2]> = pairs
+        .iter()
+        .copied()
+        .filter(|p| p.iter().all(|&g| model.geoms[g].kind.is_primitive()))
+        .collect();
+    (report.pairs, report.primitive_pairs) = (pairs.len(), primitive.len());
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut data = Data::new(model);
+    let mut mjd = mj.make_data();
+    for c in 0..=options.configs {
+        let qpos = if c == 0 { model.qpos0.clone() } else { model.random_qpos(&mut rng) };
+        model.kinematics(&qpos, &mut data);
+        mjd.qpos_mut().copy_from_slice(&qpos);
+        mjd.forward();
+        for contact in mjd.contact() {
+            let (a, b) = (contact.geom[0] as usize, contact.geom[1] as usize);
+            report.engine_contacts += 1;
+            if pairs.binary_search(&[a.min(b), a.max(b)]).is_err() {
+                report
+                    .mismatches
+                    .push(format!("config {c}: mj_collision collided {a}, {b}, not on our list"));
+            }
+        }
+        // Distances on MuJoCo's own geom poses: this compares the geometry, not the frames
+        // (MuJoCo snaps a geom frame within ~1e-6 of its body's or inertial frame onto it).
+        let mut posed = data.clone();
+        for g in 0..model.geoms.len() {
+            posed.geom_xpos[g] = Vector3::from(mjd.geom_xpos()[g]);
+            posed.geom_xmat[g] = nalgebra::Matrix3::from_row_slice(&mjd.geom_xmat()[g]);
+        }
+        for &[g1, g2] in &primitive {
+            compare_distance(model, &posed, &mut mjd, [g1, g2], c, &mut report);
+        }
+        compare_lowest_points(model, &data, &mj, &mjd, &mut report);
+    }
+    Ok(report)
+}
+
+/// How MuJoCo's `mj_geomDistance` computes a pair (`mjCOLLISIONFUNC`): 0 closed-form
+/// sphere/capsule colliders, 1 native GJK/EPA (`mjc_Convex`, `mjc_BoxBox`), 2 the other
+/// primitive colliders (`mjc_SphereBox`, `mjc_CapsuleBox`, `mjc_SphereCylinder`).
+fn mujoco_method(a: GeomType, b: GeomType) -> usize {
+    use GeomType::{Box, Capsule, Cylinder, Sphere};
+    match (a, b) {
+        (Sphere | Capsule, Sphere | Capsule) => 0,
+        (Sphere | Capsule, Box) | (Box, Sphere | Capsule) => 2,
+        (Sphere, Cylinder) | (Cylinder, Sphere) => 2,
+        _ => 1,
+    }
+}
+
+/// Signed distance of `p` from the surface of a primitive of MuJoCo's `kind`, `size` at
+/// `xpos`, `xmat` (row-major). Exact except for the ellipsoid, where it is the radial scaling
+/// residual (zero on the surface, like the others).
+fn surface_offset(
+    kind: GeomType,
+    size: [f64; 3],
+    xpos: &[f64; 3],
+    xmat: &[f64; 9],
+    p: &Vector3<f64>,
+) -> f64 {
+    let m = nalgebra::Matrix3::from_row_slice(xmat);
+    let l = m.tr_mul(&(p - Vector3::from(*xpos)));
+    let [a, b, c] = size;
+    let outside_inside =
+        |d: Vector3<f64>| d.map(|v| v.max(0.0)).norm() + d.x.max(d.y).max(d.z).min(0.0);
+    match kind {
+        GeomType::Sphere => l.norm() - a,
+        GeomType::Capsule => Vector3::new(l.x, l.y, l.z - l.z.clamp(-b, b)).norm() - a,
+        GeomType::Cylinder => {
+            let (dr, dz) = (l.x.hypot(l.y) - a, l.z.abs() - b);
+            dr.max(0.0).hypot(dz.max(0.0)) + dr.max(dz).min(0.0)
+        }
+        GeomType::Box => outside_inside(l.abs() - Vector3::new(a, b, c)),
+        _ => (l.component_div(&Vector3::new(a, b, c)).norm() - 1.0) * a.min(b).min(c),
+    }
+}
+
+fn compare_distance(
+    model: &Model,
+    data: &Data,
+    mjd: &mut mujoco_rs::prelude::MjData<&MjModel>,
+    [g1, g2]: [usize; 2],
+    config: usize,
+    report: &mut CollisionReport,
+) {
+    // Ask both for more than NEAR so that a pair near the threshold is seen by both.
+    let reach = 2.0 * NEAR;
+    let mut fromto = [0.0; 6];
+    let theirs = mjd.geom_distance(g1, g2, reach, Some(&mut fromto));
+    let ours = crate::geom_distance(model, data, g1, g2, reach);
+    if theirs >= NEAR && ours.is_none_or(|p| p.distance >= NEAR) {
+        return;
+    }
+    let Some(p) = ours else {
+        report.mismatches.push(format!(
+            "config {config}: geoms {g1}, {g2}: mujoco distance {theirs:.6}, ours none"
+        ));
+        return;
+    };
+    let (k1, k2) = (model.geoms[g1].kind, model.geoms[g2].kind);
+    let (from, to) = (
+        Vector3::new(fromto[0], fromto[1], fromto[2]),
+        Vector3::new(fromto[3], fromto[4], fromto[5]),
+    );
+    let (xpos, xmat) = (mjd.geom_xpos(), mjd.geom_xmat());
+    let size = |g: usize| model.geoms[g].size;
+    let surface = surface_offset(k1, size(g1), &xpos[g1], &xmat[g1], &p.point1)
+        .abs()
+        .max(surface_offset(k2, size(g2), &xpos[g2], &xmat[g2], &p.point2).abs());
+    let point = (p.point1 - from).norm().max((p.point2 - to).norm());
+    let penetrating = p.distance < 0.0 || theirs < 0.0;
+    let method = mujoco_method(k1, k2);
+    if method == 2 && penetrating {
+        report.shallower += usize::from(p.distance < theirs);
+        if p.distance > theirs + 1e-9 {
+            report.mismatches.push(format!(
+                "config {config}: geoms {g1}, {g2} ({k1:?}, {k2:?}): ours {:.6} shallower than mujoco's {theirs:.6}",
+                p.distance
+            ));
+        }
+        report.primitive.surface = report.primitive.surface.max(surface);
+        return;
+    }
+    let normal = (theirs.abs() > 1e-3).then(|| (p.normal - (to - from) / theirs).norm());
+    let stats = match method {
+        0 => &mut report.closed_form,
+        1 => &mut report.gjk,
+        _ => &mut report.primitive,
+    };
+    stats.add(penetrating, (p.distance - theirs).abs(), surface, point, normal);
+}
+
+fn compare_lowest_points(
+    model: &Model,
+    data: &Data,
+    mj: &MjModel,
+    mjd: &mujoco_rs::prelude::MjData<&MjModel>,
+    report: &mut CollisionReport,
+) {
+    let (xpos, xmat, size) = (mjd.geom_xpos(), mjd.geom_xmat(), mj.geom_size());
+    for (g, geom) in model.geoms.iter().enumerate() {
+        let Some(low) = crate::geom_lowest_point(model, data, g) else { continue };
+        let c = Vector3::from(xpos[g]);
+        // xmat is row-major: rz is the world-z row, the local axes' heights.
+        let m = nalgebra::Matrix3::from_row_slice(&xmat[g]);
+        let rz = m.row(2).transpose();
+        let [a, b, h] = size[g];
+        let (extent, outside) = {
+            let l = m.tr_mul(&(low - c));
+            match geom.kind {
+                GeomType::Sphere => (a, l.norm() - a),
+                GeomType::Capsule => {
+                    (b * rz.z.abs() + a, Vector3::new(l.x, l.y, l.z - l.z.clamp(-b, b)).norm() - a)
+                }
+                GeomType::Cylinder => (
+                    // √(1 − R_zz²), precisely
+                    b * rz.z.abs() + a * rz.x.hypot(rz.y),
+                    (l.x.hypot(l.y) - a).max(l.z.abs() - b),
+                ),
+                GeomType::Box => (
+                    a * rz.x.abs() + b * rz.y.abs() + h * rz.z.abs(),
+                    (l.x.abs() - a).max(l.y.abs() - b).max(l.z.abs() - h),
+                ),
+                _ => {
+                    let s = Vector3::new(a, b, h);
+                    (s.component_mul(&rz).norm(), l.component_div(&s).norm() - 1.0)
+                }
+            }
+        };
+        let dev = (low.z - (c.z - extent)).abs().max(outside.max(0.0));
+        let dxmat = (data.geom_xmat[g] - m).norm();
+        let allowance = dxmat * Vector3::from(size[g]).norm() + (data.geom_xpos[g] - c).norm();
+        report.max_xmat = report.max_xmat.max(dxmat);
+        report.max_lowest = report.max_lowest.max(dev - allowance);
+    }
+}

@@ -1,8 +1,10 @@
 //! The typed MJCF tree: what the file says, attribute by attribute, before any default,
 //! class, unit or frame is applied (that is `compile`'s job). Only the parts that matter for
-//! kinematics are kept; elements that cannot change a body pose (actuators, sensors, assets,
-//! contact, visual, ...) are skipped, and elements that would change one but are not
-//! implemented are an [`Error::Unsupported`](crate::Error::Unsupported).
+//! kinematics and collision filtering are kept (geom `contype`/`conaffinity`, `<contact>`'s
+//! `<exclude>` and `<pair>`, `<option><flag filterparent>`); elements that cannot change a body
+//! pose or which geoms may collide (actuators, sensors, assets, visual, ...) are skipped, and
+//! elements that would change one but are not implemented are an
+//! [`Error::Unsupported`](crate::Error::Unsupported).
 
 use crate::error::Error;
 use crate::model::{GeomType, JointType};
@@ -60,6 +62,8 @@ pub(crate) struct GeomAttrs {
     pub orientation: Option<(Orientation, Pos)>,
     pub fromto: Option<[f64; 6]>,
     pub mesh: Option<String>,
+    pub contype: Option<i32>,
+    pub conaffinity: Option<i32>,
 }
 
 #[derive(Debug, Clone)]
@@ -110,22 +114,37 @@ pub(crate) struct BodySpec {
     pub pos: Pos,
 }
 
+/// A name as written in an attribute, with where it was written (resolved by `compile`).
+#[derive(Debug, Clone)]
+pub(crate) struct NameRef {
+    pub name: String,
+    pub pos: Pos,
+}
+
+/// `<contact>`: `<exclude body1 body2>` and `<pair geom1 geom2>`, in file order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactSpec {
+    pub excludes: Vec<[NameRef; 2]>,
+    pub pairs: Vec<[NameRef; 2]>,
+}
+
 #[derive(Debug, Clone)]
 pub(crate) struct Mjcf {
     pub model_name: Option<String>,
     pub compiler: CompilerSpec,
     pub default: DefaultSpec,
     pub worldbody: BodySpec,
+    pub contact: ContactSpec,
+    /// `<option><flag filterparent>`: `None` when not written (MuJoCo's default: enabled).
+    pub filterparent: Option<bool>,
 }
 
-/// Top-level sections that cannot change body poses: skipped.
+/// Top-level sections that cannot change body poses or collision filtering: skipped.
 const IGNORED_SECTIONS: &[&str] = &[
-    "option",
     "size",
     "visual",
     "statistic",
     "asset",
-    "contact",
     "equality",
     "tendon",
     "actuator",
@@ -159,10 +178,14 @@ pub(crate) fn parse(root: &Element, src: &Sources) -> Result<Mjcf, Error> {
             items: Vec::new(),
             pos: root.pos,
         },
+        contact: ContactSpec::default(),
+        filterparent: None,
     };
     for el in &root.children {
         match el.name.as_str() {
             "compiler" => parse_compiler(el, src, &mut mjcf.compiler)?,
+            "option" => parse_option(el, src, &mut mjcf.filterparent)?,
+            "contact" => parse_contact(el, src, &mut mjcf.contact)?,
             "default" => parse_top_default(el, src, &mut mjcf.default)?,
             "worldbody" => {
                 for child in &el.children {
@@ -201,6 +224,36 @@ fn parse_compiler(el: &Element, src: &Sources, c: &mut CompilerSpec) -> Result<(
             }
             _ => {}
         }
+    }
+    Ok(())
+}
+
+/// `<option>`: only `<flag filterparent="enable|disable">` matters here (the last one wins,
+/// as when MuJoCo reads several `<option>` elements).
+fn parse_option(el: &Element, src: &Sources, filterparent: &mut Option<bool>) -> Result<(), Error> {
+    for flag in el.children.iter().filter(|c| c.name == "flag") {
+        if let Some(a) = flag.attr("filterparent") {
+            *filterparent = Some(keyword(a, src, &[("enable", true), ("disable", false)])?);
+        }
+    }
+    Ok(())
+}
+
+/// `<contact>`: `<exclude body1 body2>` and `<pair geom1 geom2>` (both names required, as in
+/// MuJoCo); the contact parameters of a pair (condim, friction, margin, ...) are not kept.
+fn parse_contact(el: &Element, src: &Sources, contact: &mut ContactSpec) -> Result<(), Error> {
+    for child in &el.children {
+        let (list, keys) = match child.name.as_str() {
+            "exclude" => (&mut contact.excludes, ["body1", "body2"]),
+            "pair" => (&mut contact.pairs, ["geom1", "geom2"]),
+            _ => continue,
+        };
+        let name = |key: &str| {
+            child.attr(key).map(|a| NameRef { name: a.value.clone(), pos: a.pos }).ok_or_else(
+                || src.invalid(child.pos, format!("<{}> needs the attribute {key}", child.name)),
+            )
+        };
+        list.push([name(keys[0])?, name(keys[1])?]);
     }
     Ok(())
 }
@@ -364,6 +417,8 @@ fn geom_attrs(el: &Element, src: &Sources) -> Result<GeomAttrs, Error> {
             "pos" => g.pos = Some(floats::<3>(a, src)?),
             "fromto" => g.fromto = Some(floats::<6>(a, src)?),
             "mesh" => g.mesh = Some(a.value.clone()),
+            "contype" => g.contype = Some(int(a, src)?),
+            "conaffinity" => g.conaffinity = Some(int(a, src)?),
             _ => {}
         }
     }
@@ -425,6 +480,12 @@ fn floats<const N: usize>(a: &Attr, src: &Sources) -> Result<[f64; N], Error> {
     let mut out = [0.0; N];
     out.copy_from_slice(&values);
     Ok(out)
+}
+
+fn int(a: &Attr, src: &Sources) -> Result<i32, Error> {
+    a.value.trim().parse::<i32>().map_err(|_| {
+        src.invalid(a.pos, format!("attribute {}=\"{}\": not an integer", a.name, a.value))
+    })
 }
 
 fn boolean(a: &Attr, src: &Sources) -> Result<bool, Error> {

@@ -698,6 +698,9 @@ impl<'s> Builder<'s> {
                 jnt_pos_zero: Vec::new(),
                 geom_mat: Vec::new(),
                 site_mat: Vec::new(),
+                contact_excludes: Vec::new(),
+                contact_pairs: Vec::new(),
+                filter_parent: true,
             },
             body_geoms: vec![Vec::new()],
             geom_names: HashSet::new(),
@@ -866,6 +869,9 @@ impl<'s> Builder<'s> {
             pos: placed.pos,
             quat: placed.quat,
             mesh,
+            // MuJoCo's defaults: URDF has no collision filter of its own.
+            contype: 1,
+            conaffinity: 1,
         });
     }
 

@@ -27,10 +27,43 @@
 //! - **Floating**: a frame floats when both feet have `h ≥ contact_height`; the floating
 //!   height of a frame is `max(0, min(h_left, h_right))` (cm).
 //! - **Root height**: z of the first body (the floating base), m.
+//!
+//! Metrics of the literature, as holosoma's evaluation code defines them (amazon-far/holosoma,
+//! `src/holosoma_retargeting/holosoma_retargeting/evaluation/eval_retargeting.py`,
+//! `RetargetingEvaluator.evaluate_penetration` and `detect_foot_sliding`; its later strict
+//! variant `evaluation/metrics.py`, `foot_skating_metrics` and `summarize_penetration_depths`,
+//! read in the public copies mstoelzle/holosoma@604e9d4 and Kisechan/holosoma@5757131):
+//!
+//! - **Ground penetration** over every collision geom of the robot (primitive geoms of
+//!   non-world bodies with `contype` or `conaffinity` set), not only the feet: a frame's depth
+//!   is `max(0, ground − lowest z)` over those geoms ([`mjcf::geom_lowest_point`]; holosoma asks
+//!   `mj_geomDistance` against its ground plane, which is the same number). A frame
+//!   **penetrates** when its depth exceeds [`ReportOptions::penetration_tolerance`] (1 cm,
+//!   holosoma's `penetration_tolerance`, strict `>`); the **duration** is penetrating frames /
+//!   frames; the **max depth** is over all frames.
+//! - **Skating** (needs the source's foot contacts): a foot's speed at frame t is
+//!   `|xy[t] − xy[t−1]| · fps` of its body origin, 0 at frame 0 (holosoma: backward
+//!   differences with a leading 0). A foot **skates** in a frame when the source foot is in
+//!   contact and its speed exceeds [`ReportOptions::skate_speed`] (0.3 m/s: holosoma's strict
+//!   threshold; its legacy one is 0.01 m per frame at its 30 fps). The **duration** is frames
+//!   with a skating foot / frames with a foot in source contact (holosoma counts frames, either
+//!   foot, not foot samples); the **max speed** is over skating samples. Holosoma tracks a toe
+//!   body (`*_ankle_roll_sphere_5_link` on its G1); we track the foot body.
+//! - **Stance** (needs the source's foot contacts; not in holosoma): over the foot × frame
+//!   samples where the source foot is in contact, the share where the foot height `h` (above)
+//!   is above [`ReportOptions::stance_float_height`] (2 cm: **floating in stance**) and the
+//!   share with `h` within [`ReportOptions::sole_band`] ([−0.5, +1.0] cm).
+//! - **Self-collision** (not in holosoma): over [`mjcf::Model::collision_pairs`] between robot
+//!   geoms (primitives, neither on the world body), less the pairs already touching or
+//!   penetrating at `qpos0` (distance ≤ 0: the model's own design), frames with any pair deeper
+//!   than [`ReportOptions::self_collision_depth`] (1 cm), frames with any penetration, the
+//!   largest depth and its pair ([`mjcf::geom_distance`]).
+//! - **Joint speed over limit**: per hinge or slide joint with a published
+//!   [`mjcf::Joint::velocity_limit`], frames × joints with `|q̇| > limit` (`q̇` as above) and the
+//!   largest `|q̇| / limit`; `None` when no joint has a limit.
 
 use std::fmt;
 
-use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::motion::RobotMotion;
@@ -55,6 +88,19 @@ pub struct ReportOptions {
     pub joint_velocity_limit: Option<f64>,
     /// Slack before a joint counts as outside its range (rad or m). Default 1e-6.
     pub limit_tolerance: f64,
+    /// A frame penetrates the ground when a collision geom is deeper than this (m). Default
+    /// 0.01 (holosoma).
+    pub penetration_tolerance: f64,
+    /// A foot in source contact skates above this horizontal speed (m/s). Default 0.3
+    /// (holosoma's strict threshold, 0.01 m per frame at 30 fps).
+    pub skate_speed: f64,
+    /// A foot in source contact floats above this height (m). Default 0.02.
+    pub stance_float_height: f64,
+    /// Foot heights (m) counted as resting on the ground in source contact. Default
+    /// [−0.005, 0.01].
+    pub sole_band: [f64; 2],
+    /// Self-collision frames count pairs deeper than this (m). Default 0.01.
+    pub self_collision_depth: f64,
 }
 
 impl Default for ReportOptions {
@@ -67,6 +113,11 @@ impl Default for ReportOptions {
             slide_speed: 0.1,
             joint_velocity_limit: None,
             limit_tolerance: 1e-6,
+            penetration_tolerance: 0.01,
+            skate_speed: 0.3,
+            stance_float_height: 0.02,
+            sole_band: [-0.005, 0.01],
+            self_collision_depth: 0.01,
         }
     }
 }
@@ -159,6 +210,84 @@ pub struct Range {
     pub max: f64,
 }
 
+/// Ground penetration of every collision geom (see the module documentation).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GroundPenetration {
+    /// Collision geoms considered.
+    pub geoms: usize,
+    /// [`ReportOptions::penetration_tolerance`] (cm).
+    pub tolerance_cm: f64,
+    /// Frames deeper than the tolerance.
+    pub frames: usize,
+    /// `frames` / all frames (holosoma's `penetration_duration`).
+    pub duration: f64,
+    /// Deepest penetration over all frames (cm), 0 without any.
+    pub max_depth_cm: f64,
+    /// The geom of the deepest penetration (its name, or `geom N` when it has none).
+    pub worst_geom: Option<String>,
+}
+
+/// Robot self-collision (see the module documentation).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SelfCollision {
+    /// Geom pairs checked.
+    pub pairs: usize,
+    /// Pairs left out because they touch or overlap at `qpos0`.
+    pub ignored_pairs: usize,
+    /// [`ReportOptions::self_collision_depth`] (cm).
+    pub deep_cm: f64,
+    /// Frames with a pair deeper than `deep_cm`.
+    pub frames_deep: usize,
+    /// Frames with any penetrating pair.
+    pub frames_penetrating: usize,
+    /// Deepest penetration (cm), 0 without any.
+    pub max_depth_cm: f64,
+    /// The two geoms of the deepest penetration.
+    pub worst_pair: Option<[String; 2]>,
+}
+
+/// Foot skating against the source's contacts (holosoma's `foot_skating_metrics`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Skating {
+    /// [`ReportOptions::skate_speed`] (m/s).
+    pub threshold_mps: f64,
+    /// Frames with a foot in source contact.
+    pub stance_frames: usize,
+    /// Frames with a skating foot.
+    pub skating_frames: usize,
+    /// `skating_frames / stance_frames` (0 without stance).
+    pub duration: f64,
+    /// Fastest skating foot (m/s), 0 without any.
+    pub max_speed: f64,
+}
+
+/// Foot height while the source foot is in contact.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Stance {
+    /// Foot × frame samples in source contact.
+    pub samples: usize,
+    /// [`ReportOptions::stance_float_height`] and [`ReportOptions::sole_band`] (cm).
+    pub float_cm: f64,
+    pub band_cm: [f64; 2],
+    /// Of those, samples with the foot above the floating height.
+    pub floating: usize,
+    pub floating_share: f64,
+    /// Share of samples with the foot height within the sole band.
+    pub sole_in_band_share: f64,
+}
+
+/// Joint speeds against the joints' published limits.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointSpeedLimits {
+    /// Joints with a limit.
+    pub joints: usize,
+    /// Frames × joints over their limit.
+    pub violations: usize,
+    /// Largest `|q̇| / limit`.
+    pub worst_ratio: f64,
+    pub worst_joint: String,
+}
+
 /// The quality report of one motion (serialises to JSON; `Display` prints a table).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct QualityReport {
@@ -173,6 +302,14 @@ pub struct QualityReport {
     pub floating: Floating,
     /// Root height (m).
     pub root_height: Range,
+    pub ground_penetration: GroundPenetration,
+    pub self_collision: SelfCollision,
+    /// `None` without the source's foot contacts.
+    pub skating: Option<Skating>,
+    /// `None` without the source's foot contacts.
+    pub stance: Option<Stance>,
+    /// `None` when no joint has a published speed limit.
+    pub joint_speed: Option<JointSpeedLimits>,
 }
 
 /// Computes the [`QualityReport`] of `motion` on `model` (the robot it was solved for).
@@ -182,6 +319,16 @@ pub fn report(
     opts: &ReportOptions,
 ) -> Result<QualityReport, Error> {
     check_motion(motion, model)?;
+    if let Some(c) = &motion.contacts {
+        let frames = motion.num_frames();
+        if c.left.len() != frames || c.right.len() != frames {
+            return Err(Error::Mismatch(format!(
+                "foot contacts hold {} and {} frames, the motion {frames}",
+                c.left.len(),
+                c.right.len()
+            )));
+        }
+    }
     let feet = match &opts.feet {
         Some([l, r]) => [named_body(model, l)?, named_body(model, r)?],
         None => detect_feet(model)?,
@@ -193,6 +340,9 @@ pub fn report(
         .map(|i| foot_report(model, &poses, feet[i], &heights[i].0, heights[i].1, motion.fps, opts))
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
+    let (ground_penetration, self_collision) = collisions(motion, model, opts);
+    let foot_xy = feet.map(|f| (0..frames).map(|t| poses.pos(t, f - 1).xy()).collect::<Vec<_>>());
+    let contacts = motion.contacts.as_ref().map(|c| [&c.left[..], &c.right[..]]);
     Ok(QualityReport {
         robot: model.name.clone(),
         frames,
@@ -203,7 +353,165 @@ pub fn report(
         feet: feet_reports,
         floating: floating(&heights[0].0, &heights[1].0, opts.contact_height),
         root_height: range(&root),
+        ground_penetration,
+        self_collision,
+        skating: contacts.map(|c| skating(&foot_xy, c, motion.fps, opts.skate_speed)),
+        stance: contacts.map(|c| stance(&[&heights[0].0, &heights[1].0], c, opts)),
+        joint_speed: joint_speed(motion, model),
     })
+}
+
+fn geom_label(model: &mjcf::Model, g: usize) -> String {
+    match model.geoms[g].name.as_str() {
+        "" => format!("geom {g}"),
+        name => name.to_owned(),
+    }
+}
+
+/// Ground penetration of every collision geom and self-collision, in one pass of FK.
+fn collisions(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    opts: &ReportOptions,
+) -> (GroundPenetration, SelfCollision) {
+    let robot_geom = |g: usize| model.geoms[g].body != 0 && model.geoms[g].kind.is_primitive();
+    let geoms: Vec<usize> = (0..model.geoms.len())
+        .filter(|&g| {
+            robot_geom(g) && (model.geoms[g].contype != 0 || model.geoms[g].conaffinity != 0)
+        })
+        .collect();
+    let mut data = mjcf::Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
+    let all_pairs: Vec<[usize; 2]> = model
+        .collision_pairs()
+        .into_iter()
+        .filter(|p| robot_geom(p[0]) && robot_geom(p[1]))
+        .collect();
+    let (pairs, ignored): (Vec<[usize; 2]>, Vec<[usize; 2]>) = all_pairs
+        .iter()
+        .partition(|p| mjcf::geom_distance(model, &data, p[0], p[1], 0.0).is_none());
+    let mut ground = GroundPenetration {
+        geoms: geoms.len(),
+        tolerance_cm: opts.penetration_tolerance * 100.0,
+        frames: 0,
+        duration: 0.0,
+        max_depth_cm: 0.0,
+        worst_geom: None,
+    };
+    let mut own = SelfCollision {
+        pairs: pairs.len(),
+        ignored_pairs: ignored.len(),
+        deep_cm: opts.self_collision_depth * 100.0,
+        frames_deep: 0,
+        frames_penetrating: 0,
+        max_depth_cm: 0.0,
+        worst_pair: None,
+    };
+    let (mut worst_geom, mut worst_pair) = (None, None);
+    for t in 0..motion.num_frames() {
+        model.kinematics(motion.frame(t), &mut data);
+        let mut depth = 0.0f64;
+        for &g in &geoms {
+            let Some(low) = mjcf::geom_lowest_point(model, &data, g) else { continue };
+            let d = opts.ground_height - low.z;
+            depth = depth.max(d);
+            if d * 100.0 > ground.max_depth_cm {
+                (ground.max_depth_cm, worst_geom) = (d * 100.0, Some(g));
+            }
+        }
+        ground.frames += usize::from(depth > opts.penetration_tolerance);
+        let mut deepest = None::<f64>;
+        for &[g1, g2] in &pairs {
+            let Some(p) = mjcf::geom_distance(model, &data, g1, g2, 0.0) else { continue };
+            if p.distance >= 0.0 {
+                continue;
+            }
+            deepest = Some(deepest.unwrap_or(0.0).max(-p.distance));
+            if -p.distance * 100.0 > own.max_depth_cm {
+                (own.max_depth_cm, worst_pair) = (-p.distance * 100.0, Some([g1, g2]));
+            }
+        }
+        own.frames_penetrating += usize::from(deepest.is_some());
+        own.frames_deep += usize::from(deepest.is_some_and(|d| d > opts.self_collision_depth));
+    }
+    ground.duration = ratio(ground.frames, motion.num_frames());
+    ground.worst_geom = worst_geom.map(|g| geom_label(model, g));
+    own.worst_pair = worst_pair.map(|[a, b]| [geom_label(model, a), geom_label(model, b)]);
+    (ground, own)
+}
+
+/// holosoma's `foot_skating_metrics`: backward-difference speeds with a leading 0, frames
+/// with a skating foot over frames with a foot in source contact.
+fn skating(
+    feet_xy: &[Vec<nalgebra::Vector2<f64>>; 2],
+    contacts: [&[bool]; 2],
+    fps: f64,
+    threshold: f64,
+) -> Skating {
+    let speed = |f: usize, t: usize| {
+        if t == 0 {
+            0.0
+        } else {
+            (feet_xy[f][t] - feet_xy[f][t - 1]).norm() * fps
+        }
+    };
+    let (mut stance_frames, mut skating_frames, mut max_speed) = (0, 0, 0.0f64);
+    for (t, (&left, &right)) in contacts[0].iter().zip(contacts[1]).enumerate() {
+        let stance = [left, right];
+        let skate: Vec<f64> =
+            (0..2).filter(|&f| stance[f]).map(|f| speed(f, t)).filter(|v| *v > threshold).collect();
+        stance_frames += usize::from(stance[0] || stance[1]);
+        skating_frames += usize::from(!skate.is_empty());
+        max_speed = skate.into_iter().fold(max_speed, f64::max);
+    }
+    Skating {
+        threshold_mps: threshold,
+        stance_frames,
+        skating_frames,
+        duration: ratio(skating_frames, stance_frames),
+        max_speed,
+    }
+}
+
+fn stance(heights: &[&[f64]; 2], contacts: [&[bool]; 2], opts: &ReportOptions) -> Stance {
+    let samples: Vec<f64> = (0..2)
+        .flat_map(|f| (0..contacts[f].len()).filter(move |&t| contacts[f][t]).map(move |t| (f, t)))
+        .map(|(f, t)| heights[f][t])
+        .collect();
+    let floating = samples.iter().filter(|h| **h > opts.stance_float_height).count();
+    let [lo, hi] = opts.sole_band;
+    let in_band = samples.iter().filter(|h| (lo..=hi).contains(*h)).count();
+    Stance {
+        samples: samples.len(),
+        float_cm: opts.stance_float_height * 100.0,
+        band_cm: [lo * 100.0, hi * 100.0],
+        floating,
+        floating_share: ratio(floating, samples.len()),
+        sole_in_band_share: ratio(in_band, samples.len()),
+    }
+}
+
+fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedLimits> {
+    let mut out: Option<JointSpeedLimits> = None;
+    for (j, a) in scalar_joints(model) {
+        let Some(limit) = model.joints[j].velocity_limit.filter(|l| *l > 0.0) else { continue };
+        let q: Vec<f64> = (0..motion.num_frames()).map(|t| motion.frame(t)[a]).collect();
+        let speed = gradient_rows(&q, 1, 1.0 / motion.fps);
+        let over = speed.iter().filter(|v| v.abs() > limit).count();
+        let ratio = speed.iter().fold(0.0f64, |m, v| m.max(v.abs() / limit));
+        let entry = out.get_or_insert_with(|| JointSpeedLimits {
+            joints: 0,
+            violations: 0,
+            worst_ratio: 0.0,
+            worst_joint: String::new(),
+        });
+        entry.joints += 1;
+        entry.violations += over;
+        if ratio > entry.worst_ratio || entry.worst_joint.is_empty() {
+            (entry.worst_ratio, entry.worst_joint) = (ratio, model.joints[j].name.clone());
+        }
+    }
+    out
 }
 
 fn named_body(model: &mjcf::Model, name: &str) -> Result<usize, Error> {
@@ -265,10 +573,7 @@ fn foot_heights(
         b = model.bodies[b].parent;
     };
     let geoms: Vec<usize> = (0..model.geoms.len())
-        .filter(|&g| {
-            in_foot(model.geoms[g].body)
-                && lowest_offset(&model.geoms[g], &nalgebra::Matrix3::identity()).is_some()
-        })
+        .filter(|&g| in_foot(model.geoms[g].body) && model.geoms[g].kind.is_primitive())
         .collect();
     let mut data = mjcf::Data::new(model);
     let heights = (0..motion.num_frames())
@@ -276,10 +581,8 @@ fn foot_heights(
             model.kinematics(motion.frame(t), &mut data);
             let lowest = geoms
                 .iter()
-                .filter_map(|&g| {
-                    let off = lowest_offset(&model.geoms[g], &data.geom_xmat[g])?;
-                    Some(data.geom_xpos[g].z - off)
-                })
+                .filter_map(|&g| mjcf::geom_lowest_point(model, &data, g))
+                .map(|p| p.z)
                 .fold(f64::INFINITY, f64::min);
             if lowest.is_finite() {
                 lowest
@@ -290,24 +593,6 @@ fn foot_heights(
         .map(|z| z - ground)
         .collect();
     (heights, !geoms.is_empty())
-}
-
-/// How far below its centre a primitive geom reaches, given its world orientation `r`
-/// (support function along −z); `None` for planes, height fields, meshes and SDFs.
-fn lowest_offset(geom: &mjcf::Geom, r: &nalgebra::Matrix3<f64>) -> Option<f64> {
-    let [a, b, c] = geom.size;
-    // Row z of the rotation: the world z of each local axis.
-    let z = Vector3::new(r[(2, 0)], r[(2, 1)], r[(2, 2)]);
-    Some(match geom.kind {
-        mjcf::GeomType::Sphere => a,
-        mjcf::GeomType::Capsule => a + b * z.z.abs(),
-        mjcf::GeomType::Cylinder => a * (1.0 - z.z * z.z).max(0.0).sqrt() + b * z.z.abs(),
-        mjcf::GeomType::Ellipsoid => {
-            ((a * z.x).powi(2) + (b * z.y).powi(2) + (c * z.z).powi(2)).sqrt()
-        }
-        mjcf::GeomType::Box => a * z.x.abs() + b * z.y.abs() + c * z.z.abs(),
-        _ => return None,
-    })
 }
 
 fn foot_report(
@@ -569,7 +854,70 @@ impl fmt::Display for QualityReport {
             fl.cm_max
         )?;
         let r = self.root_height;
-        writeln!(f, "root height (m): min {:.3}, mean {:.3}, max {:.3}", r.min, r.mean, r.max)
+        writeln!(f, "root height (m): min {:.3}, mean {:.3}, max {:.3}", r.min, r.mean, r.max)?;
+        self.fmt_contact_metrics(f)
+    }
+}
+
+impl QualityReport {
+    /// The metrics of the literature (module documentation), one line each.
+    fn fmt_contact_metrics(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let g = &self.ground_penetration;
+        writeln!(
+            f,
+            "\nground penetration: {} frames ({:.1}%) deeper than {:.1} cm over {} collision geoms, max {:.2} cm{}",
+            g.frames,
+            g.duration * 100.0,
+            g.tolerance_cm,
+            g.geoms,
+            g.max_depth_cm,
+            g.worst_geom.as_ref().map(|n| format!(" ({n})")).unwrap_or_default()
+        )?;
+        let s = &self.self_collision;
+        writeln!(
+            f,
+            "self-collision: {} frames deeper than {:.1} cm, {} penetrating, max {:.2} cm{}; {} pairs ({} touching at qpos0 left out)",
+            s.frames_deep,
+            s.deep_cm,
+            s.frames_penetrating,
+            s.max_depth_cm,
+            s.worst_pair.as_ref().map(|[a, b]| format!(" ({a} / {b})")).unwrap_or_default(),
+            s.pairs,
+            s.ignored_pairs
+        )?;
+        match &self.skating {
+            Some(k) => writeln!(
+                f,
+                "skating: {} of {} source-contact frames ({:.1}%) faster than {} m/s, max {:.2} m/s",
+                k.skating_frames,
+                k.stance_frames,
+                k.duration * 100.0,
+                k.threshold_mps,
+                k.max_speed
+            )?,
+            None => writeln!(f, "skating: - (no source foot contacts)")?,
+        }
+        match &self.stance {
+            Some(s) => writeln!(
+                f,
+                "stance: {} source-contact samples, {:.1}% floating above {:.1} cm, {:.1}% with the sole within [{:.1}, {:.1}] cm",
+                s.samples,
+                s.floating_share * 100.0,
+                s.float_cm,
+                s.sole_in_band_share * 100.0,
+                s.band_cm[0],
+                s.band_cm[1]
+            )?,
+            None => writeln!(f, "stance: - (no source foot contacts)")?,
+        }
+        match &self.joint_speed {
+            Some(j) => writeln!(
+                f,
+                "joint speed limits: {} frames × joints over ({} joints with limits), worst {:.2}× ({})",
+                j.violations, j.joints, j.worst_ratio, j.worst_joint
+            ),
+            None => writeln!(f, "joint speed limits: - (none published)"),
+        }
     }
 }
 
@@ -583,27 +931,5 @@ mod tests {
         assert!((percentile(&[4.0, 1.0, 3.0, 2.0], 0.95) - 3.85).abs() < 1e-12);
         assert_eq!(percentile(&[7.0], 0.99), 7.0);
         assert_eq!(percentile(&[], 0.5), 0.0);
-    }
-
-    #[test]
-    fn box_and_capsule_reach_down() {
-        let mut geom = mjcf::Geom {
-            name: String::new(),
-            body: 1,
-            kind: mjcf::GeomType::Box,
-            size: [0.1, 0.2, 0.3],
-            pos: Vector3::zeros(),
-            quat: nalgebra::UnitQuaternion::identity(),
-            mesh: None,
-        };
-        let id = nalgebra::Matrix3::identity();
-        assert_eq!(lowest_offset(&geom, &id), Some(0.3));
-        let tilted =
-            *nalgebra::Rotation3::from_euler_angles(std::f64::consts::FRAC_PI_2, 0.0, 0.0).matrix();
-        assert!((lowest_offset(&geom, &tilted).unwrap() - 0.2).abs() < 1e-12);
-        geom.kind = mjcf::GeomType::Capsule;
-        assert!((lowest_offset(&geom, &id).unwrap() - 0.3).abs() < 1e-12);
-        geom.kind = mjcf::GeomType::Mesh;
-        assert_eq!(lowest_offset(&geom, &id), None);
     }
 }

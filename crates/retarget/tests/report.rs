@@ -5,7 +5,7 @@ mod shared;
 
 use nalgebra::Vector3;
 use retarget::report::{detect_feet, report, ReportOptions};
-use retarget::{RobotMotion, TrackedTargets};
+use retarget::{FootContacts, RobotMotion, TrackedTargets};
 
 const FPS: f64 = 30.0;
 const FRAMES: usize = 40;
@@ -262,4 +262,148 @@ fn every_shipped_robot_has_its_feet_detected_on_the_right_sides() {
         checked += 1;
     }
     assert!(checked >= 6, "only {checked} robots found");
+}
+
+/// A toy robot: a box base on a free joint; spheres `a` and `b` slide towards each other
+/// along y; spheres `e` and `f` overlap by 2 cm at qpos0 (a pair the model is built with).
+const TOY: &str = r#"<mujoco model="toy"><worldbody>
+  <body name="base" pos="0 0 1"><freejoint/><geom name="base" type="box" size="0.1 0.1 0.1"/>
+    <body name="a" pos="0 0.3 0"><joint name="ja" type="slide" axis="0 1 0"/><geom name="a" size="0.05"/></body>
+    <body name="b" pos="0 -0.3 0"><joint name="jb" type="slide" axis="0 1 0"/><geom name="b" size="0.05"/></body>
+    <body name="e" pos="0.5 0 0"><joint name="je" type="slide"/><geom name="e" size="0.05"/></body>
+    <body name="f" pos="0.58 0 0"><joint name="jf" type="slide"/><geom name="f" size="0.05"/></body>
+  </body></worldbody></mujoco>"#;
+
+fn toy_motion(model: &mjcf::Model, frames: &[(f64, f64)]) -> RobotMotion {
+    // (root z, slide of `a`)
+    let mut qpos = Vec::new();
+    for &(z, qa) in frames {
+        let mut q = model.qpos0.clone();
+        q[2] = z;
+        q[model.joints[model.joint_id("ja").unwrap()].qpos_adr] = qa;
+        qpos.extend(q);
+    }
+    motion_from(model, qpos)
+}
+
+fn toy_options() -> ReportOptions {
+    ReportOptions { feet: Some(["e".to_owned(), "f".to_owned()]), ..ReportOptions::default() }
+}
+
+#[test]
+fn self_collision_is_counted_without_the_pairs_touching_at_rest() {
+    let model = mjcf::Model::from_xml_str(TOY, None).unwrap();
+    // a and b 0.6 apart at rest: slide a by −0.52 → centres 0.08 apart, 2 cm deep; by −0.505
+    // → 0.5 cm deep (penetrating, not deep).
+    let frames: Vec<(f64, f64)> =
+        [0.0; 4].into_iter().chain([-0.52; 3]).chain([-0.505; 3]).map(|qa| (1.0, qa)).collect();
+    let rep = report(&toy_motion(&model, &frames), &model, &toy_options()).unwrap();
+    let s = &rep.self_collision;
+    // Pairs: a-b, a-e, a-f, b-e, b-f, e-f (each sphere with the base is parent-child).
+    assert_eq!((s.pairs, s.ignored_pairs), (5, 1), "{s:?}");
+    assert_eq!((s.frames_deep, s.frames_penetrating), (3, 6), "{s:?}");
+    assert!((s.max_depth_cm - 2.0).abs() < 1e-9, "{s:?}");
+    assert_eq!(s.worst_pair, Some(["a".to_owned(), "b".to_owned()]));
+    assert_eq!(rep.ground_penetration.frames, 0);
+    // No contacts, no published speed limits: those metrics are absent, not zero.
+    assert!(rep.skating.is_none() && rep.stance.is_none() && rep.joint_speed.is_none());
+    let json = serde_json::to_value(&rep).unwrap();
+    assert!(json["skating"].is_null() && json["joint_speed"].is_null());
+    assert_eq!(json["self_collision"]["worst_pair"][1], "b");
+    let table = rep.to_string();
+    assert!(
+        table.contains("self-collision: 3 frames deeper than 1.0 cm, 6 penetrating"),
+        "{table}"
+    );
+    assert!(table.contains("skating: - (no source foot contacts)"), "{table}");
+}
+
+#[test]
+fn ground_penetration_covers_every_collision_geom() {
+    let model = mjcf::Model::from_xml_str(TOY, None).unwrap();
+    // The base box (half height 0.1) is the lowest geom: its bottom at z − 0.1.
+    let frames: Vec<(f64, f64)> = [1.0, 0.08, 0.095, 0.085].into_iter().map(|z| (z, 0.0)).collect();
+    let rep = report(&toy_motion(&model, &frames), &model, &toy_options()).unwrap();
+    let g = &rep.ground_penetration;
+    assert_eq!((g.geoms, g.frames), (5, 2), "{g:?}");
+    assert!((g.duration - 0.5).abs() < 1e-15);
+    assert!((g.max_depth_cm - 2.0).abs() < 1e-9, "{g:?}");
+    assert_eq!(g.worst_geom.as_deref(), Some("base"));
+    // The feet (spheres e, f: bottoms 5 cm above the box's) stay above the ground: the old
+    // per-foot metric sees nothing.
+    assert_eq!(rep.feet[0].penetration_frames, 0, "{:?}", rep.feet[0]);
+    // A geom without contype and conaffinity is no collision geom.
+    let off = TOY.replace(
+        r#"name="base" type="box""#,
+        r#"name="base" contype="0" conaffinity="0" type="box""#,
+    );
+    let model = mjcf::Model::from_xml_str(&off, None).unwrap();
+    let rep = report(&toy_motion(&model, &frames), &model, &toy_options()).unwrap();
+    let g = &rep.ground_penetration;
+    assert_eq!((g.geoms, g.frames, g.max_depth_cm, g.worst_geom.as_deref()), (4, 0, 0.0, None));
+}
+
+fn contacts(left: impl Fn(usize) -> bool, right: impl Fn(usize) -> bool) -> FootContacts {
+    FootContacts { left: (0..FRAMES).map(left).collect(), right: (0..FRAMES).map(right).collect() }
+}
+
+#[test]
+fn skating_and_stance_follow_the_source_contacts() {
+    let model = repo_g1();
+    // Frames 11..=30 move 0.02 m each (0.6 m/s, backward differences); the rest stand.
+    let (mut motion, _) = sliding_motion(&model, 0.6, 0.001);
+    motion.contacts = Some(contacts(|_| true, |t| t < 20));
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let k = rep.skating.as_ref().unwrap();
+    assert_eq!((k.stance_frames, k.skating_frames), (FRAMES, 20), "{k:?}");
+    assert!((k.duration - 0.5).abs() < 1e-15 && (k.max_speed - 0.6).abs() < 1e-9, "{k:?}");
+    // Left foot in contact for frames 0..15 only: skating frames 11..=14.
+    motion.contacts = Some(contacts(|t| t < 15, |_| false));
+    let k = report(&motion, &model, &ReportOptions::default()).unwrap().skating.unwrap();
+    assert_eq!((k.stance_frames, k.skating_frames), (15, 4), "{k:?}");
+    // 0.6 m/s is below a 1 m/s threshold.
+    let lax = ReportOptions { skate_speed: 1.0, ..ReportOptions::default() };
+    assert_eq!(report(&motion, &model, &lax).unwrap().skating.unwrap().skating_frames, 0);
+
+    // Stance: soles 1 mm up (in the band), then 3 cm up (floating) in the last 10 frames.
+    let (mut motion, _) = sliding_motion(&model, 0.0, 0.001);
+    let high = standing_height(&model, 0.03);
+    for t in 30..FRAMES {
+        motion.qpos[t * model.nq + 2] = high;
+    }
+    motion.contacts = Some(contacts(|_| true, |t| t % 2 == 0));
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let s = rep.stance.as_ref().unwrap();
+    // Samples: 40 left + 20 right; floating: frames 30..40, 10 left + 5 right.
+    assert_eq!((s.samples, s.floating), (60, 15), "{s:?}");
+    assert!((s.floating_share - 0.25).abs() < 1e-15 && (s.sole_in_band_share - 0.75).abs() < 1e-15);
+    let table = rep.to_string();
+    assert!(
+        table.contains("stance: 60 source-contact samples, 25.0% floating above 2.0 cm"),
+        "{table}"
+    );
+    // Contacts of the wrong length are an error.
+    motion.contacts = Some(FootContacts { left: vec![true; 3], right: vec![true; 3] });
+    assert!(report(&motion, &model, &ReportOptions::default()).is_err());
+}
+
+#[test]
+fn joint_speed_over_published_limits() {
+    let mut model = repo_g1();
+    let (mut motion, _) = sliding_motion(&model, 0.0, 0.0);
+    let knee = model.joint_id("left_knee_joint").unwrap();
+    let adr = model.joints[knee].qpos_adr;
+    for t in 0..FRAMES {
+        motion.qpos[t * model.nq + adr] = 0.1 + 1.5 * t as f64 / FPS; // 1.5 rad/s
+    }
+    model.joints[knee].velocity_limit = Some(1.0);
+    let elbow = model.joint_id("left_elbow_joint").unwrap();
+    model.joints[elbow].velocity_limit = Some(2.0);
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let j = rep.joint_speed.as_ref().unwrap();
+    assert_eq!((j.joints, j.violations), (2, FRAMES), "{j:?}");
+    assert!((j.worst_ratio - 1.5).abs() < 1e-9 && j.worst_joint == "left_knee_joint", "{j:?}");
+    let json = serde_json::to_value(&rep).unwrap();
+    assert_eq!(json["joint_speed"]["violations"], FRAMES);
+    assert!(rep.to_string().contains("joint speed limits: 40 frames × joints over (2 joints"));
 }
