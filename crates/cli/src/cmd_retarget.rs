@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use clap::Args;
 use retarget::writers::{write_motion, Format};
-use retarget::{ClipDiagnostics, IkConfig, RetargetOptions, RobotMotion};
+use retarget::{ClipDiagnostics, IkConfig, RetargetOptions, RobotMotion, SolveMode};
 
 use crate::shipped;
 use fk::markers::MarkerBody;
@@ -44,6 +44,10 @@ pub struct MainArgs {
     /// Output format, overriding the extension: npz, csv, pkl or json.
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
+    /// Reproduce GMR exactly (its solver and targets: no planted feet, no ground,
+    /// self-collision or joint-speed constraints). Default: the physically plausible solve.
+    #[arg(long)]
+    pub gmr: bool,
 }
 
 /// The default IK config of each shipped robot (`configs/bvh_lafan1_to_<key>.json`).
@@ -76,7 +80,9 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     let config = resolve_config(&robot, args.config.as_deref())?;
     let model = shipped::robot_model(&robot)?;
     let started = Instant::now();
-    let options = RetargetOptions { human_height: args.human_height, ..RetargetOptions::default() };
+    let mode = if args.gmr { SolveMode::Gmr } else { SolveMode::default() };
+    let options =
+        RetargetOptions { human_height: args.human_height, mode, ..RetargetOptions::default() };
     let (motion, diag) = if args.c3d.is_some() {
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
         let markers = MarkerConfig::from_file(config_path)?;

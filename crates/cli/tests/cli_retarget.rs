@@ -145,8 +145,8 @@ fn fps_resamples_the_output_and_unknown_robots_are_errors() {
 
 /// The G1 URDF (shared reference) as `--robot`, with the G1's LAFAN1 config: its body names
 /// are the MJCF G1's (the config names only links with joints, none of the merged ones), and
-/// the motion agrees with the one on our MJCF G1 wherever the URDF's wider joint ranges do not
-/// change the solution.
+/// GMR's solve (`--gmr`) on it agrees with the one on our MJCF G1 wherever the URDF's wider
+/// joint ranges do not change the solution; the default solve runs on it too.
 #[test]
 fn urdf_robot_retargets_with_the_g1_config() {
     let dir = temp_dir("urdf");
@@ -170,10 +170,24 @@ fn urdf_robot_retargets_with_the_g1_config() {
             config.to_str().unwrap(),
             "-o",
             path.to_str().unwrap(),
+            "--gmr",
         ]);
         assert!(out.status.success(), "{robot}: {}", text(&out).1);
         outputs.push(retarget::writers::read_motion_npz(&path).unwrap());
     }
+    // The default solve runs on the URDF too (its speed limits and collision geometry).
+    let path = dir.join("urdf_default.npz");
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        urdf.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "default solve on the URDF: {}", text(&out).1);
     let (urdf_motion, mjcf_motion) = (&outputs[0], &outputs[1]);
     assert_eq!(urdf_motion.nq, 36);
     assert_eq!(urdf_motion.joint_names, mjcf_motion.joint_names);

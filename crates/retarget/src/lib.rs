@@ -3,6 +3,9 @@
 
 pub mod chunked;
 pub mod config;
+pub mod constraints;
+pub mod contact;
+pub mod feet;
 pub mod lie;
 pub mod motion;
 pub mod pipeline;
@@ -15,5 +18,8 @@ pub mod writers;
 
 pub use config::{IkConfig, MatchEntry};
 pub use motion::{FootContacts, RobotMotion, TrackedTargets};
-pub use pipeline::{retarget_bvh, retarget_motion, ClipDiagnostics, Error, RetargetOptions};
+pub use pipeline::{
+    retarget_bvh, retarget_motion, ClipDiagnostics, Error, PlausibleOptions, RetargetOptions,
+    SolveMode, SpeedLimits,
+};
 pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};

@@ -1,5 +1,6 @@
 //! BVH → robot motion: human FK, targets, IK over every frame with warm start.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use bvh::Bvh;
@@ -8,8 +9,10 @@ use mjcf::Model;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
+use crate::constraints::Ground;
+use crate::feet::{FootPlan, RobotFoot};
 use crate::lie::Pose;
-use crate::motion::{RobotMotion, TrackedTargets};
+use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 use crate::solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};
 use crate::targets::TargetMap;
 
@@ -47,6 +50,58 @@ fn did_you_mean(nearest: &[String]) -> String {
     }
 }
 
+/// Which solve [`retarget_motion`] runs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolveMode {
+    /// GMR's algorithm and targets, reproduced exactly (`--gmr`; `tests/parity.rs`).
+    Gmr,
+    /// The default: GMR's targets and weights as the tracking objective, with the source's
+    /// contact phases planted on the floor and hard constraints (ground, joint speed).
+    Plausible(PlausibleOptions),
+}
+
+impl Default for SolveMode {
+    fn default() -> Self {
+        SolveMode::Plausible(PlausibleOptions::default())
+    }
+}
+
+/// Tunables of [`SolveMode::Plausible`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlausibleOptions {
+    pub contact: crate::contact::ContactOptions,
+    pub feet: crate::feet::FootPlanOptions,
+    /// Every collision geom stays above this height (m): the floor, for the ground
+    /// constraint.
+    pub floor: f64,
+    /// Hold the joints' speed limits (`mjcf::Joint::velocity_limit`) as hard bounds.
+    pub speed_limits: SpeedLimits,
+    /// [`SolverOptions::smoothing`] and [`SolverOptions::root_smoothing`] of this solve.
+    pub smoothing: f64,
+    pub root_smoothing: f64,
+}
+
+/// Whether the solve holds the robot's joint speed limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedLimits {
+    /// Per joint, `mjcf::Joint::velocity_limit` where it is set.
+    Robot,
+    Off,
+}
+
+impl Default for PlausibleOptions {
+    fn default() -> Self {
+        PlausibleOptions {
+            contact: crate::contact::ContactOptions::default(),
+            feet: crate::feet::FootPlanOptions::default(),
+            floor: 0.0,
+            speed_limits: SpeedLimits::Robot,
+            smoothing: 20.0,
+            root_smoothing: 60.0,
+        }
+    }
+}
+
 /// Options of [`retarget_bvh`] / [`retarget_motion`].
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RetargetOptions {
@@ -56,6 +111,16 @@ pub struct RetargetOptions {
     pub fk: FkOptions,
     /// Solve long clips as parallel chunks ([`crate::chunked`]); `None`: one serial pass.
     pub chunk: Option<crate::chunked::ChunkOptions>,
+    /// The default solve or GMR's.
+    pub mode: SolveMode,
+}
+
+impl RetargetOptions {
+    /// GMR's exact solve.
+    #[must_use]
+    pub fn gmr() -> RetargetOptions {
+        RetargetOptions { mode: SolveMode::Gmr, ..RetargetOptions::default() }
+    }
 }
 
 /// Per-clip diagnostics: per frame, and which bodies the per-body arrays refer to.
@@ -144,85 +209,247 @@ pub fn retarget_motion(
     config: &IkConfig,
     options: &RetargetOptions,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-    let height = options
-        .human_height
-        .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
-    config.validate(model, &human.body_names)?;
-    let map = TargetMap::new(config, &human.body_names, height)?;
-    let stages = task_specs(config, model, &map);
-    let mut solver = Solver::new(model, &stages, options.solver.clone())?;
-    let tracked: Vec<(usize, usize)> = solver.tracked().to_vec();
-
-    let (nb, nf, nq) = (human.num_bodies(), human.num_frames, model.nq);
-    if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
-        return Err(Error::InvalidOption(format!(
-            "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
-            human.positions.len(),
-            human.orientations.len()
-        )));
-    }
-    let dt = if human.fps > 0.0 { 1.0 / human.fps } else { 0.0 };
-    let mut poses =
-        vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; map.bodies.len()];
-    let mut qpos = Vec::with_capacity(nf * nq);
-    let mut target_pos = Vec::with_capacity(nf * tracked.len());
-    let mut target_quat = Vec::with_capacity(nf * tracked.len());
-    let mut frames = Vec::with_capacity(nf);
+    let prepared = Prepared::new(human, model, config, options)?;
     let start = Instant::now();
-    for f in 0..nf {
-        let range = f * nb..(f + 1) * nb;
-        map.compute(&human.positions[range.clone()], &human.orientations[range], &mut poses);
-        if let Some(bad) = poses.iter().position(|p| !finite_pose(p)) {
-            let message = format!("target of human body `{}` is not finite", map.bodies[bad].name);
-            return Err(Error::NonFinite { frame: f, message });
+    let solved = prepared.solve(0..human.num_frames, 0)?;
+    Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
+}
+
+/// One clip made ready to solve: every frame's targets (foot-planned in the default mode),
+/// the source's contacts and the task setup. Solving frame ranges of it independently is
+/// how [`crate::chunked`] parallelises a clip.
+pub(crate) struct Prepared<'a> {
+    model: &'a Model,
+    options: &'a RetargetOptions,
+    stages: Vec<Vec<TaskSpec>>,
+    /// `(body, target slot)` of each tracked body, as [`Solver::tracked`] orders them.
+    tracked: Vec<(usize, usize)>,
+    slots: usize,
+    /// `frames × slots` targets.
+    targets: Vec<Pose>,
+    contacts: Option<FootContacts>,
+    /// Foot bodies and per-frame weight factors (default mode).
+    plan: Option<([Option<usize>; 2], FootPlan)>,
+    fps: f64,
+    height: f64,
+}
+
+/// Solved frames of a range.
+pub(crate) struct Solved {
+    pub qpos: Vec<f64>,
+    pub frames: Vec<FrameDiagnostics>,
+}
+
+impl<'a> Prepared<'a> {
+    pub(crate) fn new(
+        human: &HumanMotion,
+        model: &'a Model,
+        config: &IkConfig,
+        options: &'a RetargetOptions,
+    ) -> Result<Prepared<'a>, Error> {
+        let height = options
+            .human_height
+            .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
+        config.validate(model, &human.body_names)?;
+        let map = TargetMap::new(config, &human.body_names, height)?;
+        let stages = task_specs(config, model, &map);
+        let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
+        let (nb, nf) = (human.num_bodies(), human.num_frames);
+        if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
+            return Err(Error::InvalidOption(format!(
+                "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
+                human.positions.len(),
+                human.orientations.len()
+            )));
         }
-        let diag = solver.solve_frame(&poses, dt);
-        if solver.qpos().iter().any(|v| !v.is_finite()) {
-            return Err(Error::NonFinite { frame: f, message: "the solver diverged".to_owned() });
+        let slots = map.bodies.len();
+        let mut targets =
+            vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
+        for f in 0..nf {
+            let range = f * nb..(f + 1) * nb;
+            let out = &mut targets[f * slots..(f + 1) * slots];
+            map.compute(&human.positions[range.clone()], &human.orientations[range], out);
+            if let Some(bad) = out.iter().position(|p| !finite_pose(p)) {
+                let message =
+                    format!("target of human body `{}` is not finite", map.bodies[bad].name);
+                return Err(Error::NonFinite { frame: f, message });
+            }
         }
-        qpos.extend_from_slice(solver.qpos());
-        for &(_, t) in &tracked {
-            let p = &poses[t];
-            target_pos.push(p.pos);
-            let q = nalgebra::Quaternion::new(p.quat[0], p.quat[1], p.quat[2], p.quat[3]);
-            target_quat.push(UnitQuaternion::new_unchecked(q));
+        let mut prepared = Prepared {
+            model,
+            options,
+            stages,
+            tracked,
+            slots,
+            targets,
+            contacts: None,
+            plan: None,
+            fps: human.fps,
+            height,
+        };
+        if let SolveMode::Plausible(plausible) = &options.mode {
+            prepared.plan_feet(human, plausible);
         }
-        frames.push(diag);
+        Ok(prepared)
     }
-    let solve_seconds = start.elapsed().as_secs_f64();
-    let body_name = |b: usize| model.bodies[b].name.clone();
-    let tracked_names: Vec<String> = tracked.iter().map(|&(b, _)| body_name(b)).collect();
-    let motion = RobotMotion {
-        fps: human.fps,
-        nq,
-        qpos,
-        joint_names: model
-            .joints
-            .iter()
-            .filter(|j| j.kind != mjcf::JointType::Free)
-            .map(|j| j.name.clone())
-            .collect(),
-        body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
-        targets: Some(TrackedTargets {
-            body_names: tracked_names.clone(),
-            pos: target_pos,
-            quat: target_quat,
-        }),
-        contacts: None,
+
+    /// Source contacts, then planted foot targets (when both the human's and the robot's
+    /// feet are found; otherwise the targets stay GMR's and only the constraints apply).
+    fn plan_feet(&mut self, human: &HumanMotion, options: &PlausibleOptions) {
+        let Some(points) = crate::contact::human_foot_points(&human.body_names) else {
+            return;
+        };
+        let contacts = crate::contact::detect(human, points, &options.contact);
+        let feet = robot_feet(self.model, &self.stages);
+        let plan = crate::feet::plan(
+            &feet,
+            &contacts,
+            &mut self.targets,
+            self.slots,
+            self.fps,
+            &options.feet,
+        );
+        self.plan = Some((feet.map(|f| f.map(|f| f.body)), plan));
+        self.contacts = Some(contacts);
+    }
+
+    /// A solver for this clip: GMR's, or with the default mode's constraints.
+    fn solver(&self) -> Result<Solver<'a>, Error> {
+        let mut options = self.options.solver.clone();
+        if let SolveMode::Plausible(p) = &self.options.mode {
+            options.smoothing = p.smoothing;
+            options.root_smoothing = p.root_smoothing;
+        }
+        let mut solver = Solver::new(self.model, &self.stages, options)?;
+        if let SolveMode::Plausible(p) = &self.options.mode {
+            solver.add_constraint(Box::new(Ground::new(self.model, p.floor)));
+            if p.speed_limits == SpeedLimits::Robot {
+                let limits: Vec<Option<f64>> =
+                    self.model.joints.iter().map(|j| j.velocity_limit).collect();
+                solver.set_speed_limits(&limits)?;
+            }
+        }
+        Ok(solver)
+    }
+
+    /// Solves frames `range`, starting from `qpos0` at frame `range.start − lead_in`
+    /// (frames of the lead-in are solved and dropped).
+    pub(crate) fn solve(&self, range: Range<usize>, lead_in: usize) -> Result<Solved, Error> {
+        let mut solver = self.solver()?;
+        let nq = self.model.nq;
+        let first = range.start.saturating_sub(lead_in);
+        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
+        let mut qpos = Vec::with_capacity(range.len() * nq);
+        let mut frames = Vec::with_capacity(range.len());
+        for f in first..range.end {
+            if let Some((bodies, plan)) = &self.plan {
+                for (body, w) in bodies.iter().zip(plan.weight[f]) {
+                    if let Some(body) = body {
+                        solver.set_weight_scale(*body, w, 1.0);
+                    }
+                }
+            }
+            let diag = solver.solve_frame(&self.targets[f * self.slots..(f + 1) * self.slots], dt);
+            if solver.qpos().iter().any(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    frame: f,
+                    message: "the solver diverged".to_owned(),
+                });
+            }
+            if f >= range.start {
+                qpos.extend_from_slice(solver.qpos());
+                frames.push(diag);
+            }
+        }
+        Ok(Solved { qpos, frames })
+    }
+
+    /// The clip's motion and diagnostics from its solved frames (all of them, in order).
+    pub(crate) fn finish(
+        &self,
+        qpos: Vec<f64>,
+        frames: Vec<FrameDiagnostics>,
+        solve_seconds: f64,
+    ) -> (RobotMotion, ClipDiagnostics) {
+        let model = self.model;
+        let nf = frames.len();
+        let mut target_pos = Vec::with_capacity(nf * self.tracked.len());
+        let mut target_quat = Vec::with_capacity(nf * self.tracked.len());
+        for f in 0..nf {
+            for &(_, t) in &self.tracked {
+                let p = &self.targets[f * self.slots + t];
+                target_pos.push(p.pos);
+                let q = nalgebra::Quaternion::new(p.quat[0], p.quat[1], p.quat[2], p.quat[3]);
+                target_quat.push(UnitQuaternion::new_unchecked(q));
+            }
+        }
+        let body_name = |b: usize| model.bodies[b].name.clone();
+        let tracked_names: Vec<String> = self.tracked.iter().map(|&(b, _)| body_name(b)).collect();
+        let motion = RobotMotion {
+            fps: self.fps,
+            nq: model.nq,
+            qpos,
+            joint_names: model
+                .joints
+                .iter()
+                .filter(|j| j.kind != mjcf::JointType::Free)
+                .map(|j| j.name.clone())
+                .collect(),
+            body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
+            targets: Some(TrackedTargets {
+                body_names: tracked_names.clone(),
+                pos: target_pos,
+                quat: target_quat,
+            }),
+            contacts: self.contacts.clone(),
+        };
+        let stages = &self.stages;
+        let weighted = |body: usize, pick: fn(&TaskSpec) -> f64| {
+            stages.iter().flatten().any(|t| t.body == body && pick(t) != 0.0)
+        };
+        let diag = ClipDiagnostics {
+            body_names: tracked_names,
+            position_tracked: self
+                .tracked
+                .iter()
+                .map(|&(b, _)| weighted(b, |t| t.pos_weight))
+                .collect(),
+            rotation_tracked: self
+                .tracked
+                .iter()
+                .map(|&(b, _)| weighted(b, |t| t.rot_weight))
+                .collect(),
+            frames,
+            human_height: self.height,
+            human_height_source: "given".to_owned(),
+            solve_seconds,
+        };
+        (motion, diag)
+    }
+
+    pub(crate) fn num_frames(&self) -> usize {
+        self.targets.len().checked_div(self.slots).unwrap_or(0)
+    }
+}
+
+/// The robot's two feet (sole bodies, as the report finds them) with the task that moves
+/// each: a task on the sole body itself, else on its nearest ancestor that has one.
+fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2] {
+    let Ok(soles) = crate::report::detect_feet(model) else {
+        return [None, None];
     };
-    let weighted = |body: usize, pick: fn(&TaskSpec) -> f64| {
-        stages.iter().flatten().any(|t| t.body == body && pick(t) != 0.0)
-    };
-    let diag = ClipDiagnostics {
-        body_names: tracked_names,
-        position_tracked: tracked.iter().map(|&(b, _)| weighted(b, |t| t.pos_weight)).collect(),
-        rotation_tracked: tracked.iter().map(|&(b, _)| weighted(b, |t| t.rot_weight)).collect(),
-        frames,
-        human_height: height,
-        human_height_source: "given".to_owned(),
-        solve_seconds,
-    };
-    Ok((motion, diag))
+    soles.map(|sole| {
+        let mut body = sole;
+        loop {
+            if let Some(task) = stages.iter().flatten().find(|t| t.body == body) {
+                return RobotFoot::new(model, body, sole, task.target);
+            }
+            if body == 0 {
+                return None;
+            }
+            body = model.bodies[body].parent;
+        }
+    })
 }
 
 /// Active entries of each enabled table as solver tasks; target slots index `map.bodies`.

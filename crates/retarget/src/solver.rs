@@ -19,8 +19,9 @@
 
 use mjcf::{Data, JointType, Model};
 
+use crate::constraints::{Constraint, StepContext};
 use crate::lie::{self, Pose};
-use crate::qp::{BoxQp, QpStatus};
+use crate::qp::{BoxQp, DenseQp, QpStatus};
 use crate::Error;
 
 /// Tunables of the solver. [`Default`] reproduces GMR.
@@ -40,6 +41,13 @@ pub struct SolverOptions {
     /// (GMR constructs a velocity limit but mink 1.3.0 ignores it, see `solve_ik`'s
     /// positional arguments). When set, `|q − q_previous frame| ≤ max_joint_speed · dt`.
     pub max_joint_speed: Option<f64>,
+    /// Weight `w` of a smoothness term `½ w |q − (2 q₋₁ − q₋₂)|²` on hinge and slide joints
+    /// (`q₋₁`, `q₋₂`: the two previous frames' solutions): it penalises joint acceleration.
+    /// GMR: 0 (none).
+    pub smoothing: f64,
+    /// The same for the free root: its position against `2 p₋₁ − p₋₂`, its orientation
+    /// (body-frame rotation vector) against `q₋₁ (q₋₂⁻¹ q₋₁)`. GMR: 0.
+    pub root_smoothing: f64,
 }
 
 impl Default for SolverOptions {
@@ -51,6 +59,8 @@ impl Default for SolverOptions {
             max_extra_steps: 10,
             limit_gain: 0.95,
             max_joint_speed: None,
+            smoothing: 0.0,
+            root_smoothing: 0.0,
         }
     }
 }
@@ -79,6 +89,9 @@ pub struct FrameDiagnostics {
     pub at_limit: Vec<usize>,
     /// QP solves that did not reach the exact optimum (should stay 0).
     pub qp_failures: usize,
+    /// Steps whose constraints could not all hold together, so that some were relaxed
+    /// (self-collision first, then joint speed); see [`Solver::add_constraint`].
+    pub relaxed_steps: usize,
 }
 
 /// Distance to a range end (rad or m) below which a joint counts as at its limit.
@@ -89,6 +102,9 @@ struct TaskWork {
     spec: TaskSpec,
     /// Cost vector C.
     cost: [f64; 6],
+    /// Per-frame factors on `cost`, position rows then rotation rows
+    /// ([`Solver::set_weight_scale`]; 1 for GMR).
+    scale: [f64; 6],
     /// Dofs moving the body (its Jacobian's non-zero columns), ascending.
     dofs: Vec<usize>,
     /// Error at the current configuration.
@@ -107,7 +123,7 @@ struct Limit {
 }
 
 /// The IK solver for one model and one set of stages. Work buffers are allocated once.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Solver<'m> {
     model: &'m Model,
     options: SolverOptions,
@@ -117,11 +133,21 @@ pub struct Solver<'m> {
     data: Data,
     qpos: Vec<f64>,
     previous: Vec<f64>,
+    /// The solution two frames back (for [`SolverOptions::smoothing`]).
+    before_previous: Vec<f64>,
+    /// Frames solved so far (the smoothing term needs two).
+    frames_solved: usize,
     dq: Vec<f64>,
     jacp: Vec<f64>,
     jacr: Vec<f64>,
     qp: BoxQp,
     qp_failures: usize,
+    /// Hard constraints beyond joint ranges, in priority order (GMR: none).
+    constraints: Vec<Box<dyn Constraint + 'm>>,
+    /// Per dof: the speed limit of its joint (rad/s or m/s), if any.
+    dof_speed: Vec<Option<f64>>,
+    dense: DenseQp,
+    relaxed_steps: usize,
 }
 
 impl<'m> Solver<'m> {
@@ -154,6 +180,7 @@ impl<'m> Solver<'m> {
                 tasks.push(TaskWork {
                     spec: *spec,
                     cost: [p, p, p, r, r, r],
+                    scale: [1.0; 6],
                     wjac: vec![[0.0; 6]; dofs.len()],
                     dofs,
                     err: nalgebra::Vector6::zeros(),
@@ -181,14 +208,54 @@ impl<'m> Solver<'m> {
             data: Data::new(model),
             qpos: model.qpos0.clone(),
             previous: model.qpos0.clone(),
+            before_previous: model.qpos0.clone(),
+            frames_solved: 0,
             dq: vec![0.0; nv],
             jacp: vec![0.0; 3 * nv],
             jacr: vec![0.0; 3 * nv],
             qp,
             qp_failures: 0,
+            constraints: Vec::new(),
+            dof_speed: vec![None; nv],
+            dense: DenseQp::new(nv),
+            relaxed_steps: 0,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
         Ok(solver)
+    }
+
+    /// Adds a hard constraint, held in every step from now on. Constraints added earlier
+    /// take priority: when a step cannot satisfy all of them (with the joint ranges and
+    /// speed limits), the later ones are dropped for that step first.
+    pub fn add_constraint(&mut self, constraint: Box<dyn Constraint + 'm>) {
+        self.constraints.push(constraint);
+    }
+
+    /// Per-joint speed limits (indexed like `Model::joints`; rad/s or m/s), held as hard
+    /// bounds `|q − q_previous frame| ≤ limit · dt` on hinge and slide joints.
+    pub fn set_speed_limits(&mut self, per_joint: &[Option<f64>]) -> Result<(), Error> {
+        if per_joint.len() != self.model.joints.len()
+            || per_joint.iter().flatten().any(|v| !(v.is_finite() && *v > 0.0))
+        {
+            return Err(Error::InvalidOption(format!(
+                "speed limits must be {} positive numbers or none",
+                self.model.joints.len()
+            )));
+        }
+        for (joint, limit) in self.model.joints.iter().zip(per_joint) {
+            if matches!(joint.kind, JointType::Hinge | JointType::Slide) {
+                self.dof_speed[joint.dof_adr] = *limit;
+            }
+        }
+        Ok(())
+    }
+
+    /// Multiplies the position and rotation weights of every task on `body` by `position`
+    /// and `rotation` (≥ 0) until changed again.
+    pub fn set_weight_scale(&mut self, body: usize, position: f64, rotation: f64) {
+        for task in self.stages.iter_mut().flatten().filter(|t| t.spec.body == body) {
+            task.scale = [position, position, position, rotation, rotation, rotation];
+        }
     }
 
     /// Current configuration.
@@ -219,8 +286,11 @@ impl<'m> Solver<'m> {
     /// Solves one frame from the current configuration. `targets` are indexed by the task
     /// specs' `target`; `dt` (seconds per frame) is used by `max_joint_speed` only.
     pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> FrameDiagnostics {
+        std::mem::swap(&mut self.before_previous, &mut self.previous);
         self.previous.copy_from_slice(&self.qpos);
+        self.frames_solved += 1;
         self.qp_failures = 0;
+        self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
         let mut error = 0.0;
         for s in 0..self.stages.len() {
@@ -236,6 +306,7 @@ impl<'m> Solver<'m> {
             rot_error,
             at_limit: self.at_limit(),
             qp_failures: self.qp_failures,
+            relaxed_steps: self.relaxed_steps,
         }
     }
 
@@ -290,17 +361,79 @@ impl<'m> Solver<'m> {
                 self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
             }
         }
+        self.add_smoothing();
         self.set_bounds(dt);
-        let status = self.qp.solve();
+        let status = if self.constraints.is_empty() {
+            let status = self.qp.solve();
+            self.dq.copy_from_slice(&self.qp.x);
+            status
+        } else {
+            self.constrained_step()
+        };
         if status != QpStatus::Optimal {
             self.qp_failures += 1;
             if status != QpStatus::IterationLimit {
                 return; // no finite step: keep the configuration
             }
         }
-        self.dq.copy_from_slice(&self.qp.x);
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
         self.model.kinematics(&self.qpos, &mut self.data);
+    }
+
+    /// The step under the general constraints, H, c and the bounds already in `self.qp`.
+    /// The box-only optimum is tried first: when it satisfies every row it is the optimum
+    /// of the constrained problem too. Otherwise the dense dual solver takes all of it; if
+    /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
+    /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
+    fn constrained_step(&mut self) -> QpStatus {
+        let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
+        self.dense.clear_rows();
+        let mut ends = Vec::with_capacity(self.constraints.len());
+        for c in &mut self.constraints {
+            c.add_rows(&ctx, &mut self.dense);
+            ends.push(self.dense.num_rows());
+        }
+        let status = self.qp.solve();
+        if status == QpStatus::Optimal && self.dense.rows_hold(&self.qp.x) {
+            self.dq.copy_from_slice(&self.qp.x);
+            return status;
+        }
+        self.dense.h.copy_from_slice(&self.qp.h);
+        self.dense.c.copy_from_slice(&self.qp.c);
+        self.dense.lb.copy_from_slice(&self.qp.lb);
+        self.dense.ub.copy_from_slice(&self.qp.ub);
+        let mut status = self.dense.solve();
+        if status == QpStatus::Infeasible {
+            self.relaxed_steps += 1;
+            status = self.relax(&ends);
+        }
+        self.dq.copy_from_slice(&self.dense.x);
+        status
+    }
+
+    /// Solves again with fewer constraints until feasible: the constraints after the first
+    /// from the last back; then all of them without the speed limits; then the first alone;
+    /// then the joint ranges alone (always feasible). `ends[k]`: rows of constraints `..=k`.
+    fn relax(&mut self, ends: &[usize]) -> QpStatus {
+        let all = self.dense.num_rows();
+        for keep in (1..ends.len()).rev() {
+            self.dense.use_rows(ends[keep - 1]);
+            let status = self.dense.solve();
+            if status != QpStatus::Infeasible {
+                return status;
+            }
+        }
+        self.set_bounds_without_speed();
+        self.dense.lb.copy_from_slice(&self.qp.lb);
+        self.dense.ub.copy_from_slice(&self.qp.ub);
+        for rows in [all, ends.first().copied().unwrap_or(0), 0] {
+            self.dense.use_rows(rows);
+            let status = self.dense.solve();
+            if status != QpStatus::Infeasible {
+                return status;
+            }
+        }
+        QpStatus::Infeasible
     }
 
     /// Adds task `k`'s `J̃ᵀJ̃` to H and `−ẽᵀJ̃` to c; returns its μ.
@@ -319,9 +452,9 @@ impl<'m> Solver<'m> {
             let (bp, br) = (rt * jp, rt * jr);
             let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
             let j = -(jlog * local);
-            *col = std::array::from_fn(|r| task.cost[r] * j[r]);
+            *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
         }
-        let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * (-task.err[r]));
+        let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
         // Upper triangle only (dofs ascending); `step` mirrors it.
         for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
@@ -334,16 +467,65 @@ impl<'m> Solver<'m> {
         self.options.lm_damping * mu
     }
 
+    /// The smoothness term: `w (q − p)` into c and `w` on the diagonal of H, with the
+    /// constant-velocity prediction `p = 2 q₋₁ − q₋₂` (from the third frame on).
+    fn add_smoothing(&mut self) {
+        let w = self.options.smoothing;
+        if (w <= 0.0 && self.options.root_smoothing <= 0.0) || self.frames_solved < 3 {
+            return;
+        }
+        let nv = self.model.nv;
+        for joint in &self.model.joints {
+            let (d, a) = (joint.dof_adr, joint.qpos_adr);
+            match joint.kind {
+                JointType::Hinge | JointType::Slide if w > 0.0 => {
+                    let predicted = 2.0 * self.previous[a] - self.before_previous[a];
+                    self.qp.h[d * nv + d] += w;
+                    self.qp.c[d] += w * (self.qpos[a] - predicted);
+                }
+                JointType::Free if self.options.root_smoothing > 0.0 => {
+                    let wr = self.options.root_smoothing;
+                    for k in 0..3 {
+                        let predicted = 2.0 * self.previous[a + k] - self.before_previous[a + k];
+                        self.qp.h[(d + k) * nv + d + k] += wr;
+                        self.qp.c[d + k] += wr * (self.qpos[a + k] - predicted);
+                    }
+                    let quat = |v: &[f64]| {
+                        nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+                            v[a + 3],
+                            v[a + 4],
+                            v[a + 5],
+                            v[a + 6],
+                        ))
+                    };
+                    let (q, q1, q2) =
+                        (quat(&self.qpos), quat(&self.previous), quat(&self.before_previous));
+                    let predicted = q1 * (q2.inverse() * q1);
+                    // Body-frame rotation from q to the prediction.
+                    let e = (q.inverse() * predicted).scaled_axis();
+                    for k in 0..3 {
+                        self.qp.h[(d + 3 + k) * nv + d + 3 + k] += wr;
+                        self.qp.c[d + 3 + k] -= wr * e[k];
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// Joint-range bounds on Δq, intersected with the speed limits (per joint, or the global
+    /// `max_joint_speed`) around the previous frame's configuration when they overlap.
     fn set_bounds(&mut self, dt: f64) {
         self.qp.lb.fill(f64::NEG_INFINITY);
         self.qp.ub.fill(f64::INFINITY);
         let gain = self.options.limit_gain;
-        let speed = self.options.max_joint_speed.filter(|v| v.is_finite() && *v > 0.0 && dt > 0.0);
+        let global = self.options.max_joint_speed.filter(|v| v.is_finite() && *v > 0.0);
+        let speed = |dof: usize| self.dof_speed[dof].or(global).filter(|_| dt > 0.0);
         for l in &self.limits {
             let q = self.qpos[l.qpos];
             let mut lb = -(gain * (q - l.range[0]));
             let mut ub = gain * (l.range[1] - q);
-            if let Some(v) = speed {
+            if let Some(v) = speed(l.dof) {
                 let reach = v * dt;
                 let (vlb, vub) =
                     (self.previous[l.qpos] - reach - q, self.previous[l.qpos] + reach - q);
@@ -354,17 +536,28 @@ impl<'m> Solver<'m> {
             self.qp.lb[l.dof] = lb;
             self.qp.ub[l.dof] = ub;
         }
-        if let Some(v) = speed {
-            for joint in &self.model.joints {
-                if matches!(joint.kind, JointType::Hinge | JointType::Slide)
-                    && joint.range.is_none()
-                {
-                    let (d, a) = (joint.dof_adr, joint.qpos_adr);
-                    let q = self.qpos[a];
-                    self.qp.lb[d] = self.previous[a] - v * dt - q;
-                    self.qp.ub[d] = self.previous[a] + v * dt - q;
-                }
+        for joint in &self.model.joints {
+            if !matches!(joint.kind, JointType::Hinge | JointType::Slide) || joint.range.is_some() {
+                continue;
             }
+            if let Some(v) = speed(joint.dof_adr) {
+                let (d, a) = (joint.dof_adr, joint.qpos_adr);
+                let q = self.qpos[a];
+                self.qp.lb[d] = self.previous[a] - v * dt - q;
+                self.qp.ub[d] = self.previous[a] + v * dt - q;
+            }
+        }
+    }
+
+    /// Joint-range bounds alone.
+    fn set_bounds_without_speed(&mut self) {
+        let gain = self.options.limit_gain;
+        self.qp.lb.fill(f64::NEG_INFINITY);
+        self.qp.ub.fill(f64::INFINITY);
+        for l in &self.limits {
+            let q = self.qpos[l.qpos];
+            self.qp.lb[l.dof] = -(gain * (q - l.range[0]));
+            self.qp.ub[l.dof] = gain * (l.range[1] - q);
         }
     }
 
@@ -411,7 +604,11 @@ fn check_options(o: &SolverOptions) -> Result<(), Error> {
         && o.stop_threshold.is_finite()
         && o.limit_gain > 0.0
         && o.limit_gain <= 1.0
-        && o.max_joint_speed.is_none_or(|v| v.is_finite() && v > 0.0);
+        && o.max_joint_speed.is_none_or(|v| v.is_finite() && v > 0.0)
+        && o.smoothing.is_finite()
+        && o.smoothing >= 0.0
+        && o.root_smoothing.is_finite()
+        && o.root_smoothing >= 0.0;
     if ok {
         Ok(())
     } else {

@@ -15,7 +15,19 @@ fn jumps(qpos: &[f64], nq: usize) -> Vec<f64> {
 }
 
 #[test]
-fn chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial_solve() {
+fn gmr_chunks_with_lead_in_have_invisible_seams_and_equal_the_serial_solve() {
+    // Measured: 3.7e-10 rad (a 2 s lead-in forgets qpos0 entirely on this take).
+    chunks_against_serial(RetargetOptions::gmr(), 1e-6);
+}
+
+#[test]
+fn default_chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial_solve() {
+    // Measured: 1.1e-4 rad: the smoothing term and the planted feet remember more of the
+    // start than GMR's solve does, and 2 s of lead-in leave that much.
+    chunks_against_serial(RetargetOptions::default(), 1e-3);
+}
+
+fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
     let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
         return;
     };
@@ -33,8 +45,7 @@ fn chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial_solve()
         orientations: full.orientations[..n * nb].to_vec(),
         ..full
     };
-    let options =
-        RetargetOptions { human_height: Some(report.height), ..RetargetOptions::default() };
+    let options = RetargetOptions { human_height: Some(report.height), ..base };
     let (serial, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     let chunk = ChunkOptions { frames: 300, lead_in: 60 };
     let (chunked, diag) =
@@ -58,6 +69,5 @@ fn chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial_solve()
     );
     // The first chunk has no lead-in and is the serial solve itself.
     assert_eq!(chunked.qpos[..chunk.frames * nq], serial.qpos[..chunk.frames * nq]);
-    // Measured: 3.7e-10 rad (a 2 s lead-in forgets qpos0 entirely on this take).
-    assert!(max_dq < 1e-6, "chunked frames differ from the serial solve by {max_dq} rad");
+    assert!(max_dq < tolerance, "chunked frames differ from the serial solve by {max_dq} rad");
 }

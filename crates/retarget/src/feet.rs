@@ -1,0 +1,330 @@
+//! Planted feet: the source's contact phases turned into foot targets that stand still on
+//! the floor.
+//!
+//! Given the per-frame targets (GMR's, from the config) and the source's contact labels:
+//!
+//! 1. **Floor**: all targets move by one vertical shift per clip, the median over the
+//!    stance samples of "how far the foot target must move for its sole to rest on z = 0"
+//!    (the source's floor becomes the robot's floor; jumps keep their height).
+//! 2. **Planting**: during a stance phase the foot target's horizontal position and yaw are
+//!    the phase's anchor ([`Anchor`]), its z puts the sole's lowest point at
+//!    [`FootPlanOptions::clearance`] for the target's tilt (heel and toe rolls stay the
+//!    source's), and the foot task's weights are multiplied by
+//!    [`FootPlanOptions::stance_weight`].
+//! 3. **Blending**: for [`FootPlanOptions::blend_s`] before touch-down and after lift-off the
+//!    target moves linearly (slerp for orientations) between the planted pose and the free
+//!    one, and so does the weight, so the foot neither jumps onto its anchor nor off it.
+//!
+//! The sole is every collision primitive on the foot body and its descendants, placed as at
+//! `qpos0` relative to the foot body.
+
+use mjcf::{Data, GeomType, Model};
+use std::ops::Range;
+
+use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+use crate::constraints::{collision_primitives, support_offset};
+use crate::contact::phases;
+use crate::lie::Pose;
+use crate::motion::FootContacts;
+
+/// Where a planted foot stays during its stance phase.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Anchor {
+    /// Where the phase began (needs no look-ahead).
+    PhaseStart,
+    /// The mean over the phase of the free target (position) and its yaw (circular mean).
+    PhaseMean,
+}
+
+/// Tunables of [`plan`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FootPlanOptions {
+    pub anchor: Anchor,
+    /// Time over which the planted offset fades in before touch-down and out after
+    /// lift-off (s).
+    pub blend_s: f64,
+    /// Planting starts this long before the source's touch-down (s), so that the foot has
+    /// arrived when the source's contact begins.
+    pub lead_s: f64,
+    /// Factor on the foot task's weights while planted.
+    pub stance_weight: f64,
+    /// Height of the sole's lowest point above the floor while planted (m).
+    pub clearance: f64,
+}
+
+impl Default for FootPlanOptions {
+    fn default() -> Self {
+        FootPlanOptions {
+            anchor: Anchor::PhaseMean,
+            blend_s: 0.2,
+            lead_s: 1.0 / 30.0,
+            stance_weight: 2.0,
+            clearance: 0.002,
+        }
+    }
+}
+
+/// A robot foot: the body whose task follows the human foot, and its sole.
+#[derive(Debug, Clone)]
+pub struct RobotFoot {
+    pub body: usize,
+    /// Target slot of the foot's task.
+    pub slot: usize,
+    /// Sole primitives: kind, size and pose relative to the foot body (at `qpos0`).
+    sole: Vec<(GeomType, [f64; 3], Isometry3<f64>)>,
+    /// The foot body's forward direction in its own frame (world +x at `qpos0`).
+    forward: Vector3<f64>,
+}
+
+impl RobotFoot {
+    /// `body` tracks target `slot`; its sole: the collision primitives of `sole_body` and its
+    /// descendants (`None` when there are none).
+    #[must_use]
+    pub fn new(model: &Model, body: usize, sole_body: usize, slot: usize) -> Option<RobotFoot> {
+        let mut data = Data::new(model);
+        model.kinematics(&model.qpos0, &mut data);
+        let body_pose = pose_of(&data.xpos[body], &data.xmat[body]);
+        let inverse = body_pose.inverse();
+        let sole: Vec<_> = collision_primitives(model)
+            .into_iter()
+            .filter(|&g| is_descendant(model, model.geoms[g].body, sole_body))
+            .map(|g| {
+                let geom = pose_of(&data.geom_xpos[g], &data.geom_xmat[g]);
+                (model.geoms[g].kind, model.geoms[g].size, inverse * geom)
+            })
+            .collect();
+        if sole.is_empty() {
+            return None;
+        }
+        let forward = data.xmat[body].transpose() * Vector3::x();
+        Some(RobotFoot { body, slot, sole, forward })
+    }
+
+    /// Height of the sole's lowest point above the foot body's origin, for a body
+    /// orientation `rot`.
+    #[must_use]
+    pub fn sole_offset(&self, rot: &UnitQuaternion<f64>) -> f64 {
+        self.sole
+            .iter()
+            .map(|(kind, size, rel)| {
+                let r = (rot * rel.rotation).to_rotation_matrix().into_inner();
+                (rot * rel.translation.vector).z + support_offset(*kind, size, &r).z
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Yaw (rad, about world z) of the foot's forward direction at orientation `rot`.
+    fn yaw(&self, rot: &UnitQuaternion<f64>) -> f64 {
+        let f = rot * self.forward;
+        f.y.atan2(f.x)
+    }
+}
+
+fn is_descendant(model: &Model, mut body: usize, ancestor: usize) -> bool {
+    loop {
+        if body == ancestor {
+            return true;
+        }
+        if body == 0 {
+            return false;
+        }
+        body = model.bodies[body].parent;
+    }
+}
+
+fn pose_of(pos: &Vector3<f64>, mat: &Matrix3<f64>) -> Isometry3<f64> {
+    let rot = UnitQuaternion::from_matrix(mat);
+    Isometry3::from_parts(Translation3::from(*pos), rot)
+}
+
+/// What [`plan`] did: the vertical shift and per frame the weight factor of each foot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FootPlan {
+    /// Added to every target's z (m).
+    pub shift: f64,
+    /// Per frame, `[left, right]` factors on the foot tasks' weights.
+    pub weight: Vec<[f64; 2]>,
+}
+
+/// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
+pub fn plan(
+    feet: &[Option<RobotFoot>; 2],
+    contacts: &FootContacts,
+    targets: &mut [Pose],
+    slots: usize,
+    fps: f64,
+    options: &FootPlanOptions,
+) -> FootPlan {
+    let frames = targets.len().checked_div(slots).unwrap_or(0);
+    let labels = [&contacts.left, &contacts.right];
+    let shift = floor_shift(feet, &labels, targets, slots, options.clearance);
+    for p in targets.iter_mut() {
+        p.pos.z += shift;
+    }
+    let blend = (options.blend_s * fps).round().max(0.0) as usize;
+    let lead = (options.lead_s * fps).round().max(0.0) as usize;
+    let mut weight = vec![[1.0; 2]; frames];
+    for (side, foot) in feet.iter().enumerate() {
+        let Some(foot) = foot else { continue };
+        let label = &labels[side][..frames.min(labels[side].len())];
+        let phase_list: Vec<Range<usize>> =
+            phases(label).into_iter().map(|r| r.start.saturating_sub(lead)..r.end).collect();
+        let free: Vec<Pose> = (0..frames).map(|t| targets[t * slots + foot.slot]).collect();
+        let mut ramp = vec![Ramp::default(); frames];
+        let mut planted = vec![false; frames];
+        for r in &phase_list {
+            let (xy, yaw) = anchor(foot, &free, r.clone(), options.anchor);
+            for t in r.clone() {
+                targets[t * slots + foot.slot] =
+                    planted_pose(foot, &free[t], xy, yaw, options.clearance);
+                planted[t] = true;
+            }
+            // Offsets at touch-down and lift-off, faded in before and out after.
+            let edges = [(r.start, -1_isize), (r.end - 1, 1)];
+            for (edge, dir) in edges {
+                let offset = Ramp::between(foot, &free[edge], &targets[edge * slots + foot.slot]);
+                for j in 1..=blend {
+                    let Some(t) = edge.checked_add_signed(dir * j as isize) else { break };
+                    if t >= frames {
+                        break;
+                    }
+                    let w = smoothstep(1.0 - j as f64 / (blend + 1) as f64);
+                    ramp[t].add(&offset, w);
+                }
+            }
+        }
+        for t in 0..frames {
+            if planted[t] {
+                weight[t][side] = options.stance_weight;
+            } else if ramp[t].weight > 0.0 {
+                targets[t * slots + foot.slot] = ramp[t].apply(&free[t]);
+                let w = ramp[t].weight.min(1.0);
+                weight[t][side] = 1.0 + (options.stance_weight - 1.0) * w;
+            }
+        }
+    }
+    FootPlan { shift, weight }
+}
+
+/// An offset of a foot target (position and yaw), accumulated with weights.
+#[derive(Debug, Clone, Copy, Default)]
+struct Ramp {
+    pos: Vector3<f64>,
+    yaw: f64,
+    weight: f64,
+}
+
+impl Ramp {
+    /// The offset that turns `free` into `planted`.
+    fn between(foot: &RobotFoot, free: &Pose, planted: &Pose) -> Ramp {
+        let yaw = wrap(foot.yaw(&quat(planted)) - foot.yaw(&quat(free)));
+        Ramp { pos: planted.pos - free.pos, yaw, weight: 1.0 }
+    }
+
+    fn add(&mut self, other: &Ramp, w: f64) {
+        self.pos += other.pos * w;
+        self.yaw += other.yaw * w;
+        self.weight += w;
+    }
+
+    fn apply(&self, free: &Pose) -> Pose {
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.yaw);
+        let q = turn * quat(free);
+        Pose { quat: [q.w, q.i, q.j, q.k], pos: free.pos + self.pos }
+    }
+}
+
+/// `3w² − 2w³`: 0 and 1 at the ends with zero slope, so the offsets fade without a kink.
+fn smoothstep(w: f64) -> f64 {
+    w * w * (3.0 - 2.0 * w)
+}
+
+/// Median over stance samples of the vertical move that rests the sole on the floor.
+fn floor_shift(
+    feet: &[Option<RobotFoot>; 2],
+    labels: &[&Vec<bool>; 2],
+    targets: &[Pose],
+    slots: usize,
+    clearance: f64,
+) -> f64 {
+    let mut moves = Vec::new();
+    for (side, foot) in feet.iter().enumerate() {
+        let Some(foot) = foot else { continue };
+        for (t, _) in labels[side].iter().enumerate().filter(|(_, c)| **c) {
+            let Some(p) = targets.get(t * slots + foot.slot) else { break };
+            moves.push(clearance - foot.sole_offset(&quat(p)) - p.pos.z);
+        }
+    }
+    if moves.is_empty() {
+        return 0.0;
+    }
+    moves.sort_by(f64::total_cmp);
+    moves[moves.len() / 2]
+}
+
+/// Anchor of one phase: horizontal position and yaw, from the free targets.
+fn anchor(
+    foot: &RobotFoot,
+    free: &[Pose],
+    range: Range<usize>,
+    kind: Anchor,
+) -> (Vector3<f64>, f64) {
+    match kind {
+        Anchor::PhaseStart => {
+            let p = &free[range.start];
+            (p.pos, foot.yaw(&quat(p)))
+        }
+        Anchor::PhaseMean => {
+            let n = range.len() as f64;
+            let (mut sum, mut s, mut c) = (Vector3::zeros(), 0.0, 0.0);
+            for p in &free[range] {
+                sum += p.pos;
+                let yaw = foot.yaw(&quat(p));
+                (s, c) = (s + yaw.sin(), c + yaw.cos());
+            }
+            (sum / n, s.atan2(c))
+        }
+    }
+}
+
+/// The planted pose: the anchor's x, y and yaw, the free target's tilt, and the height that
+/// rests the sole's lowest point at `clearance`.
+fn planted_pose(
+    foot: &RobotFoot,
+    free: &Pose,
+    anchor: Vector3<f64>,
+    yaw: f64,
+    clearance: f64,
+) -> Pose {
+    let q = quat(free);
+    let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), wrap(yaw - foot.yaw(&q)));
+    let planted = turn * q;
+    let z = clearance - foot.sole_offset(&planted);
+    Pose {
+        quat: [planted.w, planted.i, planted.j, planted.k],
+        pos: Vector3::new(anchor.x, anchor.y, z),
+    }
+}
+
+fn wrap(a: f64) -> f64 {
+    (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+}
+
+fn quat(p: &Pose) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_normalize(Quaternion::new(p.quat[0], p.quat[1], p.quat[2], p.quat[3]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smoothstep_ends_flat() {
+        assert_eq!(smoothstep(0.0), 0.0);
+        assert_eq!(smoothstep(1.0), 1.0);
+        assert!((smoothstep(0.5) - 0.5).abs() < 1e-15);
+        let slope = |w: f64| (smoothstep(w + 1e-6) - smoothstep(w - 1e-6)) / 2e-6;
+        assert!(slope(1e-6).abs() < 1e-5 && slope(1.0 - 1e-6).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,554 @@
+//! A dense convex QP with bounds and general linear inequalities, solved exactly by
+//! Goldfarb and Idnani's dual active-set method:
+//!
+//! ```text
+//! minimise ½ xᵀ H x + cᵀ x   subject to   lb ≤ x ≤ ub,   a_i · x ≥ b_i   (H positive definite)
+//! ```
+//!
+//! D. Goldfarb, A. Idnani, "A numerically stable dual method for solving strictly convex
+//! quadratic programs", *Mathematical Programming* 27 (1983) 1–33; the same algorithm as
+//! Turlach's `quadprog`. It starts at the unconstrained minimiser `−H⁻¹c` (dual feasible) and
+//! adds the most violated constraint at a time, dropping active ones whose multiplier would
+//! turn negative, so every iterate is dual feasible and the primal infeasibility falls
+//! monotonically; it ends at the exact KKT point or proves the problem infeasible. With
+//! `H = L Lᵀ` it keeps `J = L⁻ᵀ Q` and an upper-triangular `R` with `Jᵀ N = [R; 0]` (`N`: the
+//! active normals), updated by Givens rotations when a constraint enters or leaves.
+//!
+//! Why this and not an interior-point crate: our problems are tiny (`n` = 35 for the G1,
+//! a few general rows active) and a step changes little between calls. The dual method costs
+//! one Cholesky factor and a few `O(n²)` updates per active constraint, and is exact;
+//! `benches/qp.rs` measures it against `clarabel` on QPs recorded from a G1 solve.
+
+use super::QpStatus;
+
+/// A constraint of the problem: a bound of one variable or a general row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Con {
+    /// `x_i ≥ lb_i`.
+    Lower(usize),
+    /// `x_i ≤ ub_i`, i.e. `−x_i ≥ −ub_i`.
+    Upper(usize),
+    /// `a_k · x ≥ b_k`.
+    Row(usize),
+}
+
+/// Problem data and workspace. Fill `h` (row-major `n × n`, symmetric; the lower triangle is
+/// read), `c`, `lb`, `ub` (±∞ where unbounded), add general rows with [`DenseQp::add_row`],
+/// call [`DenseQp::solve`], read `x`. [`DenseQp::clear_rows`] starts the next problem's rows.
+#[derive(Debug, Clone)]
+pub struct DenseQp {
+    n: usize,
+    pub h: Vec<f64>,
+    pub c: Vec<f64>,
+    pub lb: Vec<f64>,
+    pub ub: Vec<f64>,
+    /// General rows, `rows × n` row-major, and their right-hand sides.
+    a: Vec<f64>,
+    b: Vec<f64>,
+    /// Rows taken into account: the first `in_use` ([`DenseQp::use_rows`]).
+    in_use: usize,
+    pub x: Vec<f64>,
+    /// `J` by columns: `jt[k n .. (k+1) n]` is column `k`.
+    jt: Vec<f64>,
+    /// `R` by columns: `r[k n + i] = R[i][k]`, upper triangular in the first `active.len()`.
+    r: Vec<f64>,
+    active: Vec<Con>,
+    /// Multipliers of the active constraints (same order), and of the one being added.
+    u: Vec<f64>,
+    d: Vec<f64>,
+    z: Vec<f64>,
+    dual_dir: Vec<f64>,
+    normal: Vec<f64>,
+    /// Constraints added or dropped in the last solve.
+    pub iterations: usize,
+}
+
+impl DenseQp {
+    #[must_use]
+    pub fn new(n: usize) -> DenseQp {
+        DenseQp {
+            n,
+            h: vec![0.0; n * n],
+            c: vec![0.0; n],
+            lb: vec![f64::NEG_INFINITY; n],
+            ub: vec![f64::INFINITY; n],
+            a: Vec::new(),
+            b: Vec::new(),
+            in_use: 0,
+            x: vec![0.0; n],
+            jt: vec![0.0; n * n],
+            r: vec![0.0; n * n],
+            active: Vec::with_capacity(n),
+            u: Vec::with_capacity(n + 1),
+            d: vec![0.0; n],
+            z: vec![0.0; n],
+            dual_dir: vec![0.0; n],
+            normal: vec![0.0; n],
+            iterations: 0,
+        }
+    }
+
+    #[must_use]
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// Removes every general row.
+    pub fn clear_rows(&mut self) {
+        self.a.clear();
+        self.b.clear();
+        self.in_use = 0;
+    }
+
+    /// Takes only the first `k` rows into account from now on (all rows stay stored; a
+    /// larger `k` brings them back). [`DenseQp::add_row`] makes every row count again.
+    pub fn use_rows(&mut self, k: usize) {
+        self.in_use = k.min(self.b.len());
+    }
+
+    /// Whether `x` satisfies every row in use (to a rounding tolerance).
+    #[must_use]
+    pub fn rows_hold(&self, x: &[f64]) -> bool {
+        let n = self.n;
+        (0..self.in_use).all(|k| {
+            let row = &self.a[k * n..(k + 1) * n];
+            dot(row, x) - self.b[k] >= -1e-12 * (1.0 + self.b[k].abs())
+        })
+    }
+
+    /// Adds the row `a · x ≥ b` and returns `a` (zeros) to fill in.
+    pub fn add_row(&mut self, b: f64) -> &mut [f64] {
+        let start = self.a.len();
+        self.a.resize(start + self.n, 0.0);
+        self.b.push(b);
+        self.in_use = self.b.len();
+        &mut self.a[start..]
+    }
+
+    /// Rows stored (in use or not).
+    #[must_use]
+    pub fn num_rows(&self) -> usize {
+        self.b.len()
+    }
+
+    /// Whether general row `k` is in the final active set.
+    #[must_use]
+    pub fn row_is_active(&self, k: usize) -> bool {
+        self.active.contains(&Con::Row(k))
+    }
+
+    /// Solves the problem currently stored; the minimiser is left in `x`. On
+    /// [`QpStatus::Infeasible`] `x` is the last dual-feasible iterate (it satisfies the
+    /// constraints that were active, not all of them).
+    pub fn solve(&mut self) -> QpStatus {
+        self.iterations = 0;
+        self.active.clear();
+        self.u.clear();
+        let m = self.in_use;
+        let finite_data = self.c.iter().chain(&self.b[..m]).chain(&self.a[..m * self.n]);
+        let finite_data = finite_data.into_iter().all(|v| v.is_finite());
+        let ordered_bounds =
+            self.lb.iter().zip(&self.ub).all(|(l, u)| l <= u && *l < f64::INFINITY);
+        if !finite_data || !ordered_bounds {
+            return QpStatus::Infeasible;
+        }
+        if !self.factor() {
+            return QpStatus::NotPositiveDefinite;
+        }
+        self.unconstrained();
+        let cap = 4 * (2 * self.n + m) + 20;
+        while let Some((p, slack)) = self.most_violated() {
+            match self.add_constraint(p, slack, cap) {
+                Ok(()) => {}
+                Err(status) => return status,
+            }
+        }
+        QpStatus::Optimal
+    }
+
+    /// `H = L Lᵀ`, then `J = L⁻ᵀ` (its column `k` is row `k` of `L⁻¹`).
+    fn factor(&mut self) -> bool {
+        let n = self.n;
+        // Cholesky into `r` as scratch (row-major lower triangle).
+        let l = &mut self.r;
+        for i in 0..n {
+            for j in 0..=i {
+                let mut s = self.h[i * n + j];
+                for k in 0..j {
+                    s -= l[i * n + k] * l[j * n + k];
+                }
+                if i == j {
+                    if !(s > 0.0 && s.is_finite()) {
+                        return false;
+                    }
+                    l[i * n + i] = s.sqrt();
+                } else {
+                    l[i * n + j] = s / l[j * n + j];
+                }
+            }
+        }
+        // Rows of L⁻¹ by forward substitution: Linv[i][j] = −Σ_{k=j}^{i−1} L[i][k] Linv[k][j] / L[i][i].
+        let jt = &mut self.jt;
+        jt.fill(0.0);
+        for i in 0..n {
+            let lii = l[i * n + i];
+            jt[i * n + i] = 1.0 / lii;
+            for j in 0..i {
+                let mut s = 0.0;
+                for k in j..i {
+                    s += l[i * n + k] * jt[k * n + j];
+                }
+                jt[i * n + j] = -s / lii;
+            }
+        }
+        self.r.fill(0.0);
+        true
+    }
+
+    /// `x = −J Jᵀ c`.
+    fn unconstrained(&mut self) {
+        let n = self.n;
+        self.x.fill(0.0);
+        for k in 0..n {
+            let col = &self.jt[k * n..(k + 1) * n];
+            let w = dot(col, &self.c);
+            for (xi, ji) in self.x.iter_mut().zip(col) {
+                *xi -= w * ji;
+            }
+        }
+    }
+
+    /// Slack `s = n·x − b` of a constraint (negative when violated).
+    fn slack(&self, con: Con) -> f64 {
+        match con {
+            Con::Lower(i) => self.x[i] - self.lb[i],
+            Con::Upper(i) => self.ub[i] - self.x[i],
+            Con::Row(k) => dot(&self.a[k * self.n..(k + 1) * self.n], &self.x) - self.b[k],
+        }
+    }
+
+    /// The most violated inactive constraint (slack scaled by the normal's length) beyond a
+    /// rounding tolerance, with its slack.
+    fn most_violated(&self) -> Option<(Con, f64)> {
+        let n = self.n;
+        let mut worst: Option<(Con, f64)> = None;
+        let mut worst_scaled = 0.0;
+        let tol = |scale: f64| -1e-12 * (1.0 + scale);
+        let mut consider = |con: Con, slack: f64, norm: f64, scale: f64| {
+            if slack < tol(scale) && slack / norm < worst_scaled {
+                worst_scaled = slack / norm;
+                worst = Some((con, slack));
+            }
+        };
+        for i in 0..n {
+            if self.lb[i] > f64::NEG_INFINITY && !self.active.contains(&Con::Lower(i)) {
+                consider(Con::Lower(i), self.x[i] - self.lb[i], 1.0, self.lb[i].abs());
+            }
+            if self.ub[i] < f64::INFINITY && !self.active.contains(&Con::Upper(i)) {
+                consider(Con::Upper(i), self.ub[i] - self.x[i], 1.0, self.ub[i].abs());
+            }
+        }
+        for k in 0..self.in_use {
+            if self.active.contains(&Con::Row(k)) {
+                continue;
+            }
+            let row = &self.a[k * n..(k + 1) * n];
+            let norm = dot(row, row).sqrt();
+            if norm == 0.0 {
+                continue; // 0 ≥ b: cannot be helped; a violated one stays violated
+            }
+            let slack = dot(row, &self.x) - self.b[k];
+            consider(Con::Row(k), slack, norm, self.b[k].abs());
+        }
+        worst
+    }
+
+    /// Writes the normal of `con` into `self.normal`.
+    fn load_normal(&mut self, con: Con) {
+        let n = self.n;
+        match con {
+            Con::Lower(i) => {
+                self.normal.fill(0.0);
+                self.normal[i] = 1.0;
+            }
+            Con::Upper(i) => {
+                self.normal.fill(0.0);
+                self.normal[i] = -1.0;
+            }
+            Con::Row(k) => self.normal.copy_from_slice(&self.a[k * n..(k + 1) * n]),
+        }
+    }
+
+    /// Goldfarb–Idnani steps 2–3 for the violated constraint `p`: partial and full steps
+    /// until `p` is satisfied and active.
+    fn add_constraint(&mut self, p: Con, mut slack: f64, cap: usize) -> Result<(), QpStatus> {
+        let n = self.n;
+        self.load_normal(p);
+        let mut u_p = 0.0;
+        loop {
+            self.iterations += 1;
+            if self.iterations > cap {
+                return Err(QpStatus::IterationLimit);
+            }
+            let q = self.active.len();
+            // d = Jᵀ n_p; z = J₂ d₂ (primal direction); r = R⁻¹ d₁ (dual direction).
+            for k in 0..n {
+                self.d[k] = dot(&self.jt[k * n..(k + 1) * n], &self.normal);
+            }
+            self.z.fill(0.0);
+            for k in q..n {
+                let dk = self.d[k];
+                if dk != 0.0 {
+                    for (zi, ji) in self.z.iter_mut().zip(&self.jt[k * n..(k + 1) * n]) {
+                        *zi += dk * ji;
+                    }
+                }
+            }
+            for i in (0..q).rev() {
+                let mut s = self.d[i];
+                for k in i + 1..q {
+                    s -= self.r[k * n + i] * self.dual_dir[k];
+                }
+                self.dual_dir[i] = s / self.r[i * n + i];
+            }
+            // Partial step: the first active multiplier to reach zero.
+            let (mut t1, mut drop) = (f64::INFINITY, None);
+            for i in 0..q {
+                if self.dual_dir[i] > 0.0 {
+                    let t = self.u[i] / self.dual_dir[i];
+                    if t < t1 {
+                        (t1, drop) = (t, Some(i));
+                    }
+                }
+            }
+            // Full step: the length that satisfies p (z·n_p = |d₂|² > 0 unless p depends
+            // linearly on the active normals).
+            let zn: f64 = self.d[q..].iter().map(|v| v * v).sum();
+            let nn = dot(&self.normal, &self.normal);
+            let t2 = if zn > 1e-22 * nn { -slack / zn } else { f64::INFINITY };
+            let t = t1.min(t2);
+            if t == f64::INFINITY {
+                return Err(QpStatus::Infeasible);
+            }
+            if t2.is_finite() {
+                for (xi, zi) in self.x.iter_mut().zip(&self.z) {
+                    *xi += t * zi;
+                }
+            }
+            for i in 0..q {
+                self.u[i] -= t * self.dual_dir[i];
+            }
+            u_p += t;
+            if t == t2 {
+                self.push_active(p, u_p);
+                return Ok(());
+            }
+            if let Some(i) = drop {
+                self.drop_active(i);
+            }
+            slack = self.slack(p);
+            if slack >= 0.0 {
+                // Rounding satisfied p on a partial step: nothing to add.
+                return Ok(());
+            }
+        }
+    }
+
+    /// Adds `con` (its `d = Jᵀ n` is in `self.d`): rotate `d[q+1..]` into `d[q]`, carrying
+    /// the rotations over to the columns of `J`; `R` gains the column `d[..=q]`.
+    fn push_active(&mut self, con: Con, multiplier: f64) {
+        let n = self.n;
+        let q = self.active.len();
+        for i in (q + 1..n).rev() {
+            let (a, b) = (self.d[i - 1], self.d[i]);
+            if b == 0.0 {
+                continue;
+            }
+            let h = a.hypot(b);
+            let (cs, sn) = (a / h, b / h);
+            self.d[i - 1] = h;
+            self.d[i] = 0.0;
+            rotate_columns(&mut self.jt, n, i - 1, i, cs, sn);
+        }
+        self.r[q * n..q * n + q + 1].copy_from_slice(&self.d[..=q]);
+        self.active.push(con);
+        self.u.push(multiplier);
+    }
+
+    /// Removes active constraint `i`: its column leaves `R`, the Hessenberg remainder is
+    /// made triangular again by rotating rows of `R` (and the matching columns of `J`).
+    fn drop_active(&mut self, i: usize) {
+        let n = self.n;
+        let q = self.active.len();
+        self.active.remove(i);
+        self.u.remove(i);
+        for k in i..q - 1 {
+            let (src, dst) = ((k + 1) * n, k * n);
+            self.r.copy_within(src..src + n, dst);
+        }
+        self.r[(q - 1) * n..q * n].fill(0.0);
+        for k in i..q - 1 {
+            // Zero R[k+1][k] against R[k][k].
+            let (a, b) = (self.r[k * n + k], self.r[k * n + k + 1]);
+            if b == 0.0 {
+                continue;
+            }
+            let h = a.hypot(b);
+            let (cs, sn) = (a / h, b / h);
+            for col in k..q - 1 {
+                let (x, y) = (self.r[col * n + k], self.r[col * n + k + 1]);
+                self.r[col * n + k] = cs * x + sn * y;
+                self.r[col * n + k + 1] = -sn * x + cs * y;
+            }
+            self.r[k * n + k + 1] = 0.0;
+            rotate_columns(&mut self.jt, n, k, k + 1, cs, sn);
+        }
+    }
+}
+
+/// Columns `a`, `b` of `J` become `c·Ja + s·Jb` and `−s·Ja + c·Jb`.
+fn rotate_columns(jt: &mut [f64], n: usize, a: usize, b: usize, cs: f64, sn: f64) {
+    let (lo, hi) = jt.split_at_mut(b * n);
+    let col_a = &mut lo[a * n..(a + 1) * n];
+    let col_b = &mut hi[..n];
+    for (x, y) in col_a.iter_mut().zip(col_b.iter_mut()) {
+        let (p, q) = (*x, *y);
+        *x = cs * p + sn * q;
+        *y = -sn * p + cs * q;
+    }
+}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qp::BoxQp;
+    use rand::{Rng, SeedableRng};
+
+    fn random_spd(rng: &mut impl Rng, n: usize) -> Vec<f64> {
+        let m: Vec<f64> = (0..n * n).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let mut h = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                h[i * n + j] = (0..n).map(|k| m[i * n + k] * m[j * n + k]).sum::<f64>();
+            }
+            h[i * n + i] += 0.05;
+        }
+        h
+    }
+
+    /// KKT conditions with the solver's own multipliers: primal feasibility, active
+    /// constraints tight, multipliers non-negative, and `Hx + c = Σ λ_i n_i`.
+    fn assert_kkt(qp: &DenseQp, tol: f64) {
+        let n = qp.n;
+        for i in 0..n {
+            assert!(qp.x[i] >= qp.lb[i] - tol && qp.x[i] <= qp.ub[i] + tol, "bound {i}");
+        }
+        for k in 0..qp.num_rows() {
+            let s = dot(&qp.a[k * n..(k + 1) * n], &qp.x) - qp.b[k];
+            assert!(s > -tol, "row {k} violated by {s}");
+        }
+        let mut res: Vec<f64> = (0..n)
+            .map(|i| qp.c[i] + (0..n).map(|j| qp.h[i * n + j] * qp.x[j]).sum::<f64>())
+            .collect();
+        let mut qp2 = qp.clone();
+        for (&con, &u) in qp.active.iter().zip(&qp.u) {
+            assert!(u >= -tol, "negative multiplier {u}");
+            assert!(qp.slack(con).abs() < tol, "active {con:?} not tight");
+            qp2.load_normal(con);
+            for (r, v) in res.iter_mut().zip(&qp2.normal) {
+                *r -= u * v;
+            }
+        }
+        let norm = dot(&res, &res).sqrt();
+        assert!(norm < 1e-8, "stationarity residual {norm}");
+    }
+
+    #[test]
+    fn one_row_on_a_hand_problem() {
+        // min ½|x|² − x₀ − x₁  s.t.  x₀ + x₁ ≤ 1  →  x = (½, ½).
+        let mut qp = DenseQp::new(2);
+        qp.h = vec![1.0, 0.0, 0.0, 1.0];
+        qp.c = vec![-1.0, -1.0];
+        qp.add_row(-1.0).copy_from_slice(&[-1.0, -1.0]);
+        assert_eq!(qp.solve(), QpStatus::Optimal);
+        assert!((qp.x[0] - 0.5).abs() < 1e-15 && (qp.x[1] - 0.5).abs() < 1e-15, "{:?}", qp.x);
+        assert!(qp.row_is_active(0));
+    }
+
+    #[test]
+    fn infeasible_rows_are_reported() {
+        let mut qp = DenseQp::new(1);
+        qp.h = vec![1.0];
+        qp.add_row(1.0).copy_from_slice(&[1.0]); // x ≥ 1
+        qp.add_row(0.0).copy_from_slice(&[-1.0]); // x ≤ 0
+        assert_eq!(qp.solve(), QpStatus::Infeasible);
+        let mut qp = DenseQp::new(1);
+        qp.h = vec![1.0];
+        qp.ub = vec![0.0];
+        qp.add_row(1.0).copy_from_slice(&[1.0]);
+        assert_eq!(qp.solve(), QpStatus::Infeasible);
+    }
+
+    /// Bounds only: the same minimiser as the primal box solver.
+    #[test]
+    fn bounds_match_the_box_solver() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for case in 0..300 {
+            let n = rng.gen_range(1..20);
+            let mut boxed = BoxQp::new(n);
+            boxed.h = random_spd(&mut rng, n);
+            boxed.c = (0..n).map(|_| rng.gen_range(-3.0..3.0)).collect();
+            boxed.lb = (0..n).map(|_| rng.gen_range(-1.0..0.0)).collect();
+            boxed.ub = (0..n).map(|_| rng.gen_range(0.0..1.0)).collect();
+            let mut dense = DenseQp::new(n);
+            dense.h.clone_from(&boxed.h);
+            dense.c.clone_from(&boxed.c);
+            dense.lb.clone_from(&boxed.lb);
+            dense.ub.clone_from(&boxed.ub);
+            assert_eq!(boxed.solve(), QpStatus::Optimal);
+            assert_eq!(dense.solve(), QpStatus::Optimal, "case {case}");
+            for i in 0..n {
+                assert!((boxed.x[i] - dense.x[i]).abs() < 1e-8, "case {case}: {i}");
+            }
+        }
+    }
+
+    /// Random bounds and rows around a feasible point: optimal, and KKT holds.
+    #[test]
+    fn random_problems_satisfy_kkt() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        for case in 0..300 {
+            let n = rng.gen_range(1..16);
+            let mut qp = DenseQp::new(n);
+            qp.h = random_spd(&mut rng, n);
+            qp.c = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();
+            let feasible: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.5..0.5)).collect();
+            for ((lb, ub), f) in qp.lb.iter_mut().zip(qp.ub.iter_mut()).zip(&feasible) {
+                if rng.gen_bool(0.7) {
+                    *lb = f - rng.gen_range(0.0..1.0);
+                    *ub = f + rng.gen_range(0.0..1.0);
+                }
+            }
+            for _ in 0..rng.gen_range(0..2 * n + 2) {
+                let row: Vec<f64> = (0..n).map(|_| rng.gen_range(-1.0..1.0)).collect();
+                let b = dot(&row, &feasible) - rng.gen_range(0.0..0.3);
+                qp.add_row(b).copy_from_slice(&row);
+            }
+            // A duplicate and a dependent row exercise the degenerate paths.
+            if qp.num_rows() > 1 {
+                let row = qp.a[..n].to_vec();
+                let b = qp.b[0];
+                qp.add_row(b).copy_from_slice(&row);
+                let twice: Vec<f64> = row.iter().map(|v| 2.0 * v).collect();
+                qp.add_row(2.0 * b).copy_from_slice(&twice);
+            }
+            assert_eq!(qp.solve(), QpStatus::Optimal, "case {case}");
+            assert_kkt(&qp, 1e-9);
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The small dense convex QPs of one IK step.
+//!
+//! - [`BoxQp`]: bounds only, primal active set on a tree-sparse factorisation. GMR's solve
+//!   (`--gmr`) uses it: joint ranges are its only constraints.
+//! - [`DenseQp`]: bounds plus general linear inequalities `a·x ≥ b`, Goldfarb–Idnani's dual
+//!   active-set method. The default solve uses it for the ground, self-collision, contact and
+//!   joint-speed constraints.
+
+mod boxed;
+mod dual;
+
+pub use boxed::{BoxQp, QpStatus};
+pub use dual::DenseQp;
