@@ -72,6 +72,26 @@ pub const CONVENTIONS: &[Convention] = &[
         ],
     },
     Convention {
+        name: "Xsens MVN (joints)",
+        source: "Xsens MVN BVH exports named by joint (Hips, Chest…Chest4, LeftCollar, \
+                 LeftHip, LeftKnee, LeftAnkle, LeftShoulder = upper arm; jL5S1, jT9T8)",
+        parts: &[
+            (Pelvis, &["Hips", "Pelvis"]),
+            (Spine, &["Chest", "L5S1", "L4L3"]),
+            (Chest, &["Chest4", "T9T8"]),
+            (Neck, &["Neck", "T1C7"]),
+            (Head, &["Head", "C1Head"]),
+            (Clavicle, &["{Left}Collar", "{Left}T4Shoulder"]),
+            (UpperArm, &["{Left}Shoulder"]),
+            (Forearm, &["{Left}Elbow"]),
+            (Hand, &["{Left}Wrist"]),
+            (Thigh, &["{Left}Hip"]),
+            (Shin, &["{Left}Knee"]),
+            (Foot, &["{Left}Ankle"]),
+            (Toe, &["{Left}Toe", "{Left}BallFoot"]),
+        ],
+    },
+    Convention {
         name: "CMU (3ds Max-friendly BVH) / Biovision",
         source: "CMU motion capture database, 3ds Max-friendly release (cgspeed); classic \
                  Biovision files (LeftCollar, LeftShoulder = upper arm, LeftHip = thigh)",
@@ -109,26 +129,6 @@ pub const CONVENTIONS: &[Convention] = &[
             (Shin, &["LowerLeg_{L}"]),
             (Foot, &["Foot_{L}"]),
             (Toe, &["Toes_{L}"]),
-        ],
-    },
-    Convention {
-        name: "Xsens MVN (joints)",
-        source: "Xsens MVN exports named by joint (LeftHip, LeftKnee, LeftAnkle, \
-                 LeftShoulder = upper arm; jL5S1, jT9T8)",
-        parts: &[
-            (Pelvis, &["Pelvis", "Hips"]),
-            (Spine, &["L5S1", "L4L3"]),
-            (Chest, &["T9T8"]),
-            (Neck, &["T1C7", "Neck"]),
-            (Head, &["C1Head", "Head"]),
-            (Clavicle, &["{Left}T4Shoulder"]),
-            (UpperArm, &["{Left}Shoulder"]),
-            (Forearm, &["{Left}Elbow"]),
-            (Hand, &["{Left}Wrist"]),
-            (Thigh, &["{Left}Hip"]),
-            (Shin, &["{Left}Knee"]),
-            (Foot, &["{Left}Ankle"]),
-            (Toe, &["{Left}BallFoot"]),
         ],
     },
     Convention {
@@ -298,8 +298,17 @@ pub const IGNORED_WORDS: &[&str] =
     &["twist", "roll", "ik", "prop", "weapon", "sword", "gun", "helper", "holster", "attach"];
 
 /// Exporter prefixes removed before comparing names (after the namespace, `mixamorig:`).
-const PREFIXES: &[&str] =
-    &["mixamorig_", "mixamorig", "def-", "def_", "bip001 ", "bip001_", "bip01 ", "bip01_", "cc_base_"];
+const PREFIXES: &[&str] = &[
+    "mixamorig_",
+    "mixamorig",
+    "def-",
+    "def_",
+    "bip001 ",
+    "bip001_",
+    "bip01 ",
+    "bip01_",
+    "cc_base_",
+];
 
 /// A joint name reduced for comparison: the part after the last `:` (namespaces), without
 /// an exporter prefix (`mixamorig_`, `DEF-`, `Bip01 `, `CC_Base_`, Xsens' `j` before a
@@ -393,9 +402,7 @@ pub(crate) fn side_of(name: &str, normalised_matches: &[NameMatch]) -> Option<Si
 
 /// Whether a joint name marks a helper, IK target or prop ([`IGNORED_WORDS`]).
 pub(crate) fn is_ignored(name: &str) -> bool {
-    words(name)
-        .iter()
-        .any(|w| IGNORED_WORDS.iter().any(|i| w.to_ascii_lowercase().starts_with(i)))
+    words(name).iter().any(|w| IGNORED_WORDS.iter().any(|i| w.to_ascii_lowercase().starts_with(i)))
 }
 
 /// Words of a name: split at non-alphanumerics and at lower→upper case changes

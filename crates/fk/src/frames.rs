@@ -15,8 +15,8 @@
 //!   trunk point above it; the head continues the neck's direction), y = L made perpendicular
 //!   (the chest and neck take L from the upper arms when both are given), x = y × z;
 //! - clavicle, upper arm, forearm, thigh, shin: z along the bone towards its parent joint
-//!   (e.g. thigh: knee → hip), x = F made perpendicular to z (when the bone points nearly
-//!   along F, as an arm raised forward: y = L made perpendicular, x = y × z); the hand
+//!   (e.g. thigh: knee → hip), x = F made perpendicular to z (when the bone points within 30°
+//!   of ±F, as an arm raised forward: y = L made perpendicular, x = y × z); the hand
 //!   continues the forearm's axis and x;
 //! - foot, toe: x = heel-to-toe direction (foot → toe) made perpendicular to U (F when there
 //!   is no toe), z = U made perpendicular to x.
@@ -34,13 +34,17 @@ use crate::roles::{Part, Role, Side};
 
 /// Shorter vectors than this (relative to the body's size) have no direction.
 const DEGENERATE: f64 = 1e-6;
+/// sin 30°: a limb closer than this to the forward axis takes its x from the left axis.
+const ALONG_FORWARD: f64 = 0.5;
 
 /// Canonical frame (world-from-frame rotation, in the input's coordinates) of every role
 /// whose geometry the given points determine. `points` are joint positions per role in any
 /// unit; the pelvis, a point above it and a left-right pair (thighs or upper arms) are needed
 /// for any frame at all.
 #[must_use]
-pub fn canonical_frames(points: &BTreeMap<Role, Vector3<f64>>) -> BTreeMap<Role, UnitQuaternion<f64>> {
+pub fn canonical_frames(
+    points: &BTreeMap<Role, Vector3<f64>>,
+) -> BTreeMap<Role, UnitQuaternion<f64>> {
     let mut out = BTreeMap::new();
     let Some(body) = BodyAxes::new(points) else {
         return out;
@@ -155,16 +159,22 @@ impl BodyAxes {
     }
 
     /// z given, y from `left` made perpendicular to z, x = y × z.
-    fn frame_from_z_and_y(&self, z: Vector3<f64>, left: Vector3<f64>) -> Option<UnitQuaternion<f64>> {
+    fn frame_from_z_and_y(
+        &self,
+        z: Vector3<f64>,
+        left: Vector3<f64>,
+    ) -> Option<UnitQuaternion<f64>> {
         let y = unit(left - z * z.dot(&left), 1.0)?;
         Some(self.rotation(y.cross(&z), y, z))
     }
 
-    /// A limb bone's frame: z given; x = forward made perpendicular to z, unless the bone is
-    /// closer to forward than to left (then y from left, x = y × z).
+    /// A limb bone's frame: z given; x = forward made perpendicular to z, unless the bone
+    /// points within 30° of forward or backward (then y from left, x = y × z). The switch is
+    /// far from hanging, T- and A-pose limbs, where both rules would be valid but differ.
     fn limb_frame(&self, z: Vector3<f64>) -> Option<UnitQuaternion<f64>> {
-        if z.dot(&self.forward).abs() <= z.dot(&self.left).abs() {
-            let x = unit(self.forward - z * z.dot(&self.forward), 1.0)?;
+        let across = self.forward - z * z.dot(&self.forward);
+        if across.norm() >= ALONG_FORWARD {
+            let x = across.normalize();
             Some(self.rotation(x, z.cross(&x), z))
         } else {
             self.frame_from_z_and_y(z, self.left)

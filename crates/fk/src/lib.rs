@@ -94,7 +94,10 @@ impl FkReport {
                 h.rest_pose
             ),
             Err(_) => {
-                format!("{up}, {unit} ({} m/unit), skeleton not recognised as a humanoid", self.metres_per_unit)
+                format!(
+                    "{up}, {unit} ({} m/unit), skeleton not recognised as a humanoid",
+                    self.metres_per_unit
+                )
             }
         }
     }
@@ -118,9 +121,8 @@ fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
     let file = ToWorld::new(&AxisConvention::ZUp, 1.0);
     let n = bvh.motion.num_frames;
     let count = n.min(SAMPLED_FRAMES);
-    let picked: Vec<usize> = (0..count)
-        .map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 })
-        .collect();
+    let picked: Vec<usize> =
+        (0..count).map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 }).collect();
     let motion = &bvh.motion;
     let sub = Bvh {
         skeleton: bvh.skeleton.clone(),
@@ -156,7 +158,9 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
         other => other,
     };
     let (axes, axes_reason) = match (options.axes, &humanoid) {
-        (AxisConvention::Auto, Ok(h)) => (h.up.convention(), format!("{} up: {}", h.up, h.up_reason)),
+        (AxisConvention::Auto, Ok(h)) => {
+            (h.up.convention(), format!("{} up: {}", h.up, h.up_reason))
+        }
         (AxisConvention::Auto, Err(_)) => {
             (AxisConvention::YUp, "+Y up assumed (the BVH norm): no humanoid recognised".to_owned())
         }

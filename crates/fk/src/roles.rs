@@ -411,9 +411,11 @@ pub(crate) fn recognise(
         None => (from_names(&tree, &names), "names (no body plan found in the hierarchy)".into()),
     };
     for (role, name) in given {
-        let index = skeleton.joints.iter().position(|j| &j.name == name).ok_or_else(|| {
-            Error::UnknownRoleJoint { role: *role, name: name.clone() }
-        })?;
+        let index = skeleton
+            .joints
+            .iter()
+            .position(|j| &j.name == name)
+            .ok_or_else(|| Error::UnknownRoleJoint { role: *role, name: name.clone() })?;
         roles.insert(*role, names.joint(index, Rule::Given));
     }
     let missing = roles.missing_required();
@@ -547,7 +549,11 @@ fn from_plan(tree: &Tree, names: &Names, plan: &BodyPlan, samples: &Samples) -> 
             let role = Role::of(part, side);
             roles.insert(role, names.pick(role, &run.joints, run.default, &why));
         };
-        put(Part::Thigh, &leg.proximal, format!("carries the leg's first long bone ({})", leg.reading));
+        put(
+            Part::Thigh,
+            &leg.proximal,
+            format!("carries the leg's first long bone ({})", leg.reading),
+        );
         put(Part::Shin, &leg.distal, "carries the leg's second long bone".to_owned());
         put(Part::Foot, &leg.extremity, "at the end of the shin bone (the ankle)".to_owned());
         if let Some(tip) = &leg.tip {
@@ -620,7 +626,8 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
             default = neck_allowed.get(i).copied();
         }
         if let Some(default) = default {
-            let neck = names.pick(Role::Neck, &neck_allowed, default, "between the chest and the head");
+            let neck =
+                names.pick(Role::Neck, &neck_allowed, default, "between the chest and the head");
             roles.insert(Role::Neck, neck);
         }
         roles.insert(Role::Head, head);
@@ -629,7 +636,7 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
     // that carries a bone of its own.
     if let Some(trunk) = tree.path_down(pelvis.index, chest) {
         let between: Vec<usize> = trunk[1..trunk.len() - 1].to_vec();
-        let start = trunk.iter().position(|&j| j == plan.pelvis).map_or(0, |i| i.saturating_sub(0));
+        let start = trunk.iter().position(|&j| j == plan.pelvis).unwrap_or(0);
         let mut default = trunk.get(start + 1).copied().filter(|j| between.contains(j));
         while let Some(j) = default {
             match tree.children[j].iter().find(|c| between.contains(c) && tree.is_zero(**c)) {
@@ -638,8 +645,12 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
             }
         }
         if let Some(default) = default {
-            let spine =
-                names.pick(Role::Spine, &between, default, "first joint of the trunk above the pelvis");
+            let spine = names.pick(
+                Role::Spine,
+                &between,
+                default,
+                "first joint of the trunk above the pelvis",
+            );
             roles.insert(Role::Spine, spine);
         }
     }
@@ -687,14 +698,20 @@ fn sides<'p>(
 /// the subject's left is up × forward, up runs from the pelvis to the head, forward is where
 /// the toes point (else where the knees bend). Votes over the zero pose and the sampled
 /// frames; `None` when no pose shows a facing.
-fn geometric_sides(tree: &Tree, plan: &BodyPlan, samples: &Samples) -> Option<(bool, bool, String)> {
-    let head = plan.head_chain.iter().rev().find(|&&j| !tree.end_site[j]).copied().unwrap_or(plan.chest);
+fn geometric_sides(
+    tree: &Tree,
+    plan: &BodyPlan,
+    samples: &Samples,
+) -> Option<(bool, bool, String)> {
+    let head =
+        plan.head_chain.iter().rev().find(|&&j| !tree.end_site[j]).copied().unwrap_or(plan.chest);
     let poses = std::iter::once(&samples.rest).chain(samples.frames.iter().map(|(_, p, _)| p));
     let (mut legs, mut arms, mut by_toes, mut by_knees, mut total) = (0_i64, 0_i64, 0, 0, 0);
     for p in poses {
         total += 1;
         let up = p[head] - p[plan.pelvis];
-        let flat = |v: Vector3<f64>| v - up * (up.dot(&v) / up.norm_squared().max(f64::MIN_POSITIVE));
+        let flat =
+            |v: Vector3<f64>| v - up * (up.dot(&v) / up.norm_squared().max(f64::MIN_POSITIVE));
         let toes: Vector3<f64> = plan
             .legs
             .iter()
@@ -705,7 +722,8 @@ fn geometric_sides(tree: &Tree, plan: &BodyPlan, samples: &Samples) -> Option<(b
             .legs
             .iter()
             .map(|l| {
-                let (hip, knee, ankle) = (p[l.proximal.default], p[l.distal.default], p[l.extremity.default]);
+                let (hip, knee, ankle) =
+                    (p[l.proximal.default], p[l.distal.default], p[l.extremity.default]);
                 flat(knee - (hip + ankle) / 2.0)
             })
             .sum();
@@ -721,8 +739,10 @@ fn geometric_sides(tree: &Tree, plan: &BodyPlan, samples: &Samples) -> Option<(b
         };
         let left = up.cross(&forward);
         let vote = |x: f64| if x > 0.0 { 1 } else { -1 };
-        legs += vote(left.dot(&(p[plan.legs[0].proximal.default] - p[plan.legs[1].proximal.default])));
-        arms += vote(left.dot(&(p[plan.arms[0].proximal.default] - p[plan.arms[1].proximal.default])));
+        legs +=
+            vote(left.dot(&(p[plan.legs[0].proximal.default] - p[plan.legs[1].proximal.default])));
+        arms +=
+            vote(left.dot(&(p[plan.arms[0].proximal.default] - p[plan.arms[1].proximal.default])));
     }
     if by_toes + by_knees == 0 || legs == 0 || arms == 0 {
         return None;
@@ -796,8 +816,10 @@ fn up_axis(key: &Key, samples: &Samples) -> (UpAxis, String) {
     };
     let up = best(&sum).unwrap_or(UpAxis::PosY);
     let agree = poses.iter().filter(|p| best(&direction(p)) == Some(up)).count();
-    let what = if samples.frames.is_empty() { "the zero pose (no frames)" } else { "sampled frames" };
-    let reason = format!("the head is above the feet along {up} in {agree} of {} {what}", poses.len());
+    let what =
+        if samples.frames.is_empty() { "the zero pose (no frames)" } else { "sampled frames" };
+    let reason =
+        format!("the head is above the feet along {up} in {agree} of {} {what}", poses.len());
     (up, reason)
 }
 
@@ -825,8 +847,9 @@ fn rest_pose(key: &Key, rest: &[Vector3<f64>], up: UpAxis) -> (RestPose, String)
             format!("in the zero pose pelvis → head points along {axis}, not {up}: the zero pose is not used"),
         );
     }
-    let elevation = [0, 1]
-        .map(|s| cos(rest[key.hands[s]] - rest[key.upper_arms[s]]).clamp(-1.0, 1.0).asin().to_degrees());
+    let elevation = [0, 1].map(|s| {
+        cos(rest[key.hands[s]] - rest[key.upper_arms[s]]).clamp(-1.0, 1.0).asin().to_degrees()
+    });
     let mean = (elevation[0] + elevation[1]) / 2.0;
     let kind = if mean > T_POSE_BELOW {
         RestPose::ArmsUp

@@ -61,12 +61,7 @@ pub(crate) fn choose_units(diameter: f64) -> (f64, String) {
 /// 1.6 m typical, 0.8–2.4 m human; fingers, face and props do not count.
 #[must_use]
 pub(crate) fn choose_units_from_stature(path: f64) -> (f64, String) {
-    choose(Proxy {
-        value: path,
-        range: (0.8, 2.4),
-        typical: 1.6,
-        what: "head-to-ankle bone path",
-    })
+    choose(Proxy { value: path, range: (0.8, 2.4), typical: 1.6, what: "head-to-ankle bone path" })
 }
 
 /// The candidate whose result is closest (in ratio) to the typical value, among those in the

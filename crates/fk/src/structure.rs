@@ -14,8 +14,9 @@
 //!   `LHipJoint`, `lhand`); of the remaining bones, the proximal long bone (thigh, upper arm)
 //!   and the distal one (shin, forearm) are the consecutive pair whose length ratio, with the
 //!   bone before them as the girdle (clavicle), is closest to human proportions
-//!   ([`LimbKind`]); a limb that ends at a branching joint (a hand with fingers) ends at the
-//!   distal bone. Everything after it is the extremity (foot, hand) and, on legs, the toe.
+//!   ([`LimbKind`]); bones before the girdle that the reading leaves unexplained cost extra.
+//!   The joint at the end of the distal bone is the extremity (foot, hand) and, on legs, the
+//!   joint at the end of the next bone the toe.
 
 use crate::conventions;
 
@@ -54,7 +55,9 @@ impl Tree {
         let length: Vec<f64> = skeleton
             .joints
             .iter()
-            .map(|j| if j.parent.is_some() { nalgebra::Vector3::from(j.offset).norm() } else { 0.0 })
+            .map(
+                |j| if j.parent.is_some() { nalgebra::Vector3::from(j.offset).norm() } else { 0.0 },
+            )
             .collect();
         let mut reach = vec![0.0_f64; n];
         for i in (0..n).rev() {
@@ -219,11 +222,12 @@ impl Tree {
             terms.iter().sum::<f64>() / terms.len() as f64
                 + UNEXPLAINED_BONE * k.saturating_sub(1) as f64
         };
-        let (k, reading) = if branching && !self.end_site[*path.last()?] {
-            (n - 2, "the limb ends where it branches (fingers): its last two bones")
+        let k = (0..n - 1).min_by(|&a, &b| score(a).total_cmp(&score(b)))?;
+        let reading = if branching {
+            "of the bones up to where the limb branches, the consecutive pair closest to human \
+             proportions"
         } else {
-            let k = (0..n - 1).min_by(|&a, &b| score(a).total_cmp(&score(b)))?;
-            (k, "the consecutive bone pair closest to human proportions")
+            "the consecutive bone pair closest to human proportions"
         };
         let run_back = |i: usize| -> Run {
             // path[i] carries a non-zero bone; joints before it at the same point share it.
@@ -315,7 +319,7 @@ impl Tree {
     }
 
     /// Every (pelvis, two legs, chest, two arms, head) reading, scored by how far the limbs
-    /// reach: `2·min(legs) + 2·min(arms) + pelvis→chest + head`.
+    /// reach: `2·min(legs) + 2·min(arms) + pelvis→chest + min(head, arms)`.
     fn candidates(&self) -> Vec<Candidate> {
         let mut out = Vec::new();
         for pelvis in 0..self.len() {
@@ -359,13 +363,17 @@ impl Tree {
             if self.end_site[chest] || kids.len() < 2 {
                 continue;
             }
-            let rise: f64 =
-                self.path_down(pelvis, chest).map_or(0.0, |p| p[1..].iter().map(|&j| self.length[j]).sum());
+            let rise: f64 = self
+                .path_down(pelvis, chest)
+                .map_or(0.0, |p| p[1..].iter().map(|&j| self.length[j]).sum());
             for (x, &c) in kids.iter().enumerate() {
                 for &d in &kids[x + 1..] {
                     let head = self.head_branch(pelvis, chest, &[c, d]);
-                    let arms = 2.0 * self.branch(c).min(self.branch(d));
-                    let head_reach = head.map_or(0.0, |h| self.branch(h));
+                    let arm = self.branch(c).min(self.branch(d));
+                    let arms = 2.0 * arm;
+                    // A head never reaches farther than an arm: this keeps a long prop in one
+                    // hand from making that arm the "head".
+                    let head_reach = head.map_or(0.0, |h| self.branch(h).min(arm));
                     found(chest, [c, d], head, arms + rise + head_reach);
                 }
             }
@@ -384,7 +392,7 @@ impl Tree {
             return Some(h);
         }
         let trunk = self.path_down(pelvis, chest)?;
-        trunk.windows(2).rev().skip(0).find_map(|w| {
+        trunk.windows(2).rev().find_map(|w| {
             let (joint, on_path) = (w[0], w[1]);
             if joint == pelvis {
                 return None;
