@@ -7,7 +7,7 @@
 //! `Bip01 `, Xsens' `j`) removed, case and separators ignored. So `Bip01 L Thigh`, `L Thigh`
 //! and `l_thigh` are the same name.
 //!
-//! Names only choose among what the hierarchy allows ([`crate::roles`]): the same name means
+//! Names only choose among what the hierarchy allows ([`crate::recognise`]): the same name means
 //! different parts in different conventions (`LeftShoulder` is the clavicle in Mixamo and the
 //! upper arm in CMU's 3ds Max release and in Xsens' joint naming; `L_Foot` is SMPL's toe), and
 //! the convention that names most of the skeleton is consulted first.

@@ -387,13 +387,16 @@ impl Humanoid {
     }
 }
 
+/// One sampled frame: its index, positions and orientations of every joint.
+pub(crate) type SampledFrame = (usize, Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
+
 /// World poses of a few frames, in file axes and units: what the recogniser looks at.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Samples {
     /// The zero pose: positions (orientations are all identity).
     pub(crate) rest: Vec<Vector3<f64>>,
     /// `(frame index, positions, orientations)` of evenly spaced frames of the motion.
-    pub(crate) frames: Vec<(usize, Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>)>,
+    pub(crate) frames: Vec<SampledFrame>,
 }
 
 /// Recognise the humanoid in `skeleton` from its hierarchy, names and the sampled poses;

@@ -95,7 +95,7 @@ impl Tree {
         self.children[j]
             .iter()
             .copied()
-            .filter(|&c| !self.ignored[c] && !(self.end_site[c] && self.is_zero(c)))
+            .filter(|&c| !(self.ignored[c] || (self.end_site[c] && self.is_zero(c))))
             .collect()
     }
 

@@ -58,6 +58,7 @@ fn expect_owned(
     file: &str,
     names: &([String; 5], [[String; 4]; 2], [[String; 4]; 2]),
 ) {
+    #[allow(clippy::ptr_arg)] // mapped over arrays of String
     fn s(v: &String) -> &str {
         v.as_str()
     }
