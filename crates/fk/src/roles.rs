@@ -595,69 +595,76 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
         plan.pelvis,
         "where the legs meet the trunk (or above it, by name)",
     );
+    // 3ds Max Biped hangs the clavicles on the neck: the chest is then the joint below it.
     let arms_at = plan.chest;
     let arms_at_neck = names.says(arms_at, Part::Neck) && !names.says(arms_at, Part::Chest);
     let below_arms = plan.trunk.len().checked_sub(2).map(|i| plan.trunk[i]);
-    let (chest, neck_at_arms) = match below_arms {
-        Some(below) if arms_at_neck && below != plan.pelvis => (below, true),
-        _ => (arms_at, false),
+    let (chest, why) = match below_arms {
+        Some(below) if arms_at_neck && below != plan.pelvis => {
+            (below, "below the neck, from which the arms branch")
+        }
+        _ => (arms_at, "where the arms branch off the trunk"),
     };
-    let chest_why = if neck_at_arms {
-        "below the neck, from which the arms branch"
-    } else {
-        "where the arms branch off the trunk"
-    };
-    roles.insert(Role::Chest, names.pick(Role::Chest, &[chest], chest, chest_why));
-    // Head: the end of the head chain (before face, eyes or the head-top End Site).
-    let chain: Vec<usize> =
-        plan.head_chain.iter().copied().filter(|&j| !tree.end_site[j]).collect();
-    if let Some(&last) = chain.last() {
-        let head =
-            names.pick(Role::Head, &chain, last, "the last joint of the chain from the chest up");
-        let head_at = chain.iter().position(|&j| j == head.index).unwrap_or(chain.len() - 1);
-        let mut neck_allowed: Vec<usize> = chain[..head_at].to_vec();
-        if neck_at_arms {
-            neck_allowed.insert(0, arms_at);
-        }
-        let mut default = neck_allowed.first().copied();
-        if !neck_at_arms {
-            // Skip joints at the chest's point (CMU's lowerneck sits on Chest2).
-            let mut i = 0;
-            while i + 1 < neck_allowed.len() && tree.is_zero(neck_allowed[i + 1]) {
-                i += 1;
-            }
-            default = neck_allowed.get(i).copied();
-        }
-        if let Some(default) = default {
-            let neck =
-                names.pick(Role::Neck, &neck_allowed, default, "between the chest and the head");
-            roles.insert(Role::Neck, neck);
-        }
-        roles.insert(Role::Head, head);
+    roles.insert(Role::Chest, names.pick(Role::Chest, &[chest], chest, why));
+    let neck_at_arms = (chest != arms_at).then_some(arms_at);
+    for (role, joint) in head_and_neck(tree, names, plan, neck_at_arms) {
+        roles.insert(role, joint);
     }
-    // Spine: between the pelvis and the chest; by default the first joint above the pelvis
-    // that carries a bone of its own.
-    if let Some(trunk) = tree.path_down(pelvis.index, chest) {
-        let between: Vec<usize> = trunk[1..trunk.len() - 1].to_vec();
-        let start = trunk.iter().position(|&j| j == plan.pelvis).unwrap_or(0);
-        let mut default = trunk.get(start + 1).copied().filter(|j| between.contains(j));
-        while let Some(j) = default {
-            match tree.children[j].iter().find(|c| between.contains(c) && tree.is_zero(**c)) {
-                Some(&next) => default = Some(next),
-                None => break,
-            }
-        }
-        if let Some(default) = default {
-            let spine = names.pick(
-                Role::Spine,
-                &between,
-                default,
-                "first joint of the trunk above the pelvis",
-            );
-            roles.insert(Role::Spine, spine);
-        }
+    if let Some(spine) = spine(tree, names, plan, pelvis.index, chest) {
+        roles.insert(Role::Spine, spine);
     }
     roles.insert(Role::Pelvis, pelvis);
+}
+
+/// Head: the end of the head chain (before face, eyes or the head-top End Site), or the
+/// joint so named along it. Neck: between the chest and the head, by default the first
+/// joint above the chest's point (CMU's `lowerneck` sits on `Chest2`), or `neck_at_arms`.
+fn head_and_neck(
+    tree: &Tree,
+    names: &Names,
+    plan: &BodyPlan,
+    neck_at_arms: Option<usize>,
+) -> Vec<(Role, RoleJoint)> {
+    let chain: Vec<usize> =
+        plan.head_chain.iter().copied().filter(|&j| !tree.end_site[j]).collect();
+    let Some(&last) = chain.last() else { return Vec::new() };
+    let head =
+        names.pick(Role::Head, &chain, last, "the last joint of the chain from the chest up");
+    let head_at = chain.iter().position(|&j| j == head.index).unwrap_or(chain.len() - 1);
+    let mut allowed: Vec<usize> = neck_at_arms.into_iter().collect();
+    allowed.extend_from_slice(&chain[..head_at]);
+    let mut first = 0;
+    while neck_at_arms.is_none() && first + 1 < allowed.len() && tree.is_zero(allowed[first + 1]) {
+        first += 1;
+    }
+    let mut out = Vec::new();
+    if let Some(&default) = allowed.get(first) {
+        let neck = names.pick(Role::Neck, &allowed, default, "between the chest and the head");
+        out.push((Role::Neck, neck));
+    }
+    out.push((Role::Head, head));
+    out
+}
+
+/// Spine: between the pelvis and the chest; by default the first joint above the leg
+/// junction that carries a bone of its own.
+fn spine(
+    tree: &Tree,
+    names: &Names,
+    plan: &BodyPlan,
+    pelvis: usize,
+    chest: usize,
+) -> Option<RoleJoint> {
+    let trunk = tree.path_down(pelvis, chest)?;
+    let between: Vec<usize> = trunk.get(1..trunk.len().saturating_sub(1))?.to_vec();
+    let start = trunk.iter().position(|&j| j == plan.pelvis).unwrap_or(0);
+    let mut default = trunk.get(start + 1).copied().filter(|j| between.contains(j))?;
+    while let Some(&next) =
+        tree.children[default].iter().find(|c| between.contains(c) && tree.is_zero(**c))
+    {
+        default = next;
+    }
+    Some(names.pick(Role::Spine, &between, default, "first joint of the trunk above the pelvis"))
 }
 
 /// Left and right legs and arms: from names when the two chains' names state opposite sides,
