@@ -362,21 +362,28 @@ pub(crate) struct NameMatch {
 
 /// Every role a normalised name has in every convention.
 pub(crate) fn matches(normalised: &str) -> Vec<NameMatch> {
-    let mut out = Vec::new();
-    for (c, convention) in CONVENTIONS.iter().enumerate() {
-        for &(part, patterns) in convention.parts {
-            for (preference, pattern) in patterns.iter().enumerate() {
-                for &side in part.sides() {
-                    if normalise(&instantiate(pattern, side)) == normalised {
+    table().iter().filter(|(name, _)| name == normalised).map(|(_, m)| *m).collect()
+}
+
+/// Every pattern of every convention, normalised for both sides, built once.
+fn table() -> &'static [(String, NameMatch)] {
+    static TABLE: std::sync::OnceLock<Vec<(String, NameMatch)>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut out = Vec::new();
+        for (c, convention) in CONVENTIONS.iter().enumerate() {
+            for &(part, patterns) in convention.parts {
+                for (preference, pattern) in patterns.iter().enumerate() {
+                    for &side in part.sides() {
                         if let Some(role) = Role::new(part, side) {
-                            out.push(NameMatch { role, convention: c, preference });
+                            let name = normalise(&instantiate(pattern, side));
+                            out.push((name, NameMatch { role, convention: c, preference }));
                         }
                     }
                 }
             }
         }
-    }
-    out
+        out
+    })
 }
 
 /// The side a name states, from any convention's role names or from a `Left`/`Right`/`L`/`R`

@@ -373,20 +373,6 @@ pub struct Humanoid {
     pub stature_path: f64,
 }
 
-impl Humanoid {
-    /// One line: convention, roles, up axis, rest pose.
-    #[must_use]
-    pub fn summary(&self) -> String {
-        format!(
-            "{} roles ({}), {} up, rest pose {}",
-            self.roles.len(),
-            self.convention.unwrap_or("no naming convention"),
-            self.up,
-            self.rest_pose
-        )
-    }
-}
-
 /// One sampled frame: its index, positions and orientations of every joint.
 pub(crate) type SampledFrame = (usize, Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
 
