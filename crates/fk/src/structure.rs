@@ -11,7 +11,8 @@
 //!   joint whose children are alike (the fingers of a hand) or at an End Site. Joints named
 //!   as helpers or props ([`crate::conventions::IGNORED_WORDS`]) are not followed.
 //! - Along a limb, bones of zero length are skipped (several joints at one point: CMU's
-//!   `LHipJoint`, `lhand`); of the remaining bones, the proximal long bone (thigh, upper arm)
+//!   `LHipJoint`, `lhand`) and a segment split into named parts is one bone (Rigify's
+//!   `thigh.L` → `thigh.L.001`); of the remaining bones, the proximal long bone (thigh, upper arm)
 //!   and the distal one (shin, forearm) are the consecutive pair whose length ratio, with the
 //!   bone before them as the girdle (clavicle), is closest to human proportions
 //!   ([`LimbKind`]); bones before the girdle that the reading leaves unexplained cost extra.
@@ -38,6 +39,8 @@ pub(crate) struct Tree {
     /// Longest path down into the subtree (sum of bone lengths).
     reach: Vec<f64>,
     ignored: Vec<bool>,
+    /// The joint continues its parent's segment ([`continues`]).
+    continues: Vec<bool>,
     zero: f64,
 }
 
@@ -69,6 +72,11 @@ impl Tree {
         Tree {
             end_site: skeleton.joints.iter().map(|j| j.kind == bvh::JointKind::End).collect(),
             ignored: skeleton.joints.iter().map(|j| conventions::is_ignored(&j.name)).collect(),
+            continues: skeleton
+                .joints
+                .iter()
+                .map(|j| j.parent.is_some_and(|p| continues(&j.name, &skeleton.joints[p.0].name)))
+                .collect(),
             parents,
             children,
             length,
@@ -153,6 +161,47 @@ impl Tree {
     }
 }
 
+/// A bone along a limb path: from `path[carrier]` to `path[end]` (several bones when a
+/// segment is split into named parts, as Rigify's `thigh.L` → `thigh.L.001`).
+#[derive(Debug, Clone, Copy)]
+struct Bone {
+    carrier: usize,
+    end: usize,
+    length: f64,
+}
+
+impl Tree {
+    /// The non-zero bones of a limb path, split segments joined.
+    fn bones(&self, path: &[usize]) -> Vec<Bone> {
+        let mut bones: Vec<Bone> = Vec::new();
+        for i in 0..path.len().saturating_sub(1) {
+            let (carrier, length) = (path[i], self.length[path[i + 1]]);
+            if self.is_zero(path[i + 1]) {
+                continue;
+            }
+            match bones.last_mut() {
+                Some(last) if self.continues[carrier] => {
+                    last.end = i + 1;
+                    last.length += length;
+                }
+                _ => bones.push(Bone { carrier: i, end: i + 1, length }),
+            }
+        }
+        bones
+    }
+}
+
+/// Whether joint `name` continues its parent's segment: the parent's name plus a separator
+/// and digits (`thigh.L.001` under `thigh.L`).
+fn continues(name: &str, parent: &str) -> bool {
+    name.strip_prefix(parent).is_some_and(|rest| {
+        let mut chars = rest.chars();
+        matches!(chars.next(), Some('.' | '_' | '-'))
+            && !chars.as_str().is_empty()
+            && chars.all(|c| c.is_ascii_digit())
+    })
+}
+
 /// Which limb, for its typical proportions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum LimbKind {
@@ -205,14 +254,12 @@ impl Tree {
     /// Read a limb starting at `first` (a child of its junction).
     pub(crate) fn limb(&self, first: usize, kind: LimbKind) -> Option<Limb> {
         let (path, branching) = self.walk(first);
-        // Bone i runs from path[i] (its carrier) to path[i + 1].
-        let nonzero: Vec<usize> =
-            (0..path.len() - 1).filter(|&i| !self.is_zero(path[i + 1])).collect();
-        let n = nonzero.len();
+        let bones = self.bones(&path);
+        let n = bones.len();
         if n < 2 {
             return None;
         }
-        let bone = |k: usize| self.length[path[nonzero[k] + 1]];
+        let bone = |k: usize| bones[k].length;
         let (typical, girdle_typical) = kind.ratios();
         let score = |k: usize| {
             let mut terms = vec![(bone(k) / bone(k + 1) / typical).ln().powi(2)];
@@ -250,12 +297,12 @@ impl Tree {
             };
             Run { joints, default }
         };
-        let extremity_at = nonzero[k + 1] + 1;
-        let tip_at = (k + 2 < n).then(|| nonzero[k + 2] + 1);
+        let extremity_at = bones[k + 1].end;
+        let tip_at = (k + 2 < n).then(|| bones[k + 2].end);
         Some(Limb {
-            girdle: (k >= 1 && kind == LimbKind::Arm).then(|| run_back(nonzero[k - 1])),
-            proximal: run_back(nonzero[k]),
-            distal: run_back(nonzero[k + 1]),
+            girdle: (k >= 1 && kind == LimbKind::Arm).then(|| run_back(bones[k - 1].carrier)),
+            proximal: run_back(bones[k].carrier),
+            distal: run_back(bones[k + 1].carrier),
             extremity: run_forward(extremity_at),
             tip: tip_at.filter(|&i| !self.end_site[path[i]]).map(run_forward),
             extremity_end: tip_at.map(|i| path[i]),
@@ -399,5 +446,86 @@ impl Tree {
             }
             farthest(self.kids(joint).into_iter().filter(|&c| c != on_path).collect())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bvh::{Joint, JointId, JointKind, Skeleton};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn skeleton(joints: &[(&str, Option<usize>, [f64; 3])]) -> Skeleton {
+        let joints = joints
+            .iter()
+            .map(|&(name, parent, offset)| Joint {
+                name: name.to_owned(),
+                kind: match parent {
+                    None => JointKind::Root,
+                    Some(_) if name.ends_with("_End") => JointKind::End,
+                    Some(_) => JointKind::Joint,
+                },
+                parent: parent.map(JointId),
+                offset,
+                channels: Vec::new(),
+                first_channel: 0,
+            })
+            .collect();
+        Skeleton { joints }
+    }
+
+    #[test]
+    fn split_segments_are_named_parent_dot_digits() {
+        assert!(continues("DEF-thigh.L.001", "DEF-thigh.L"));
+        assert!(continues("upperarm_01", "upperarm"));
+        assert!(!continues("Spine1", "Spine"));
+        assert!(!continues("thigh.L", "thigh.L"));
+        assert!(!continues("LeftHandIndex2", "LeftHandIndex1"));
+    }
+
+    #[test]
+    fn a_leg_with_a_long_clavicle_like_hip_bone_reads_thigh_and_shin() {
+        // CMU's leg: a zero bone (LHipJoint on the hips), the hip offset, thigh, shin, foot.
+        let s = skeleton(&[
+            ("Hips", None, [0.0; 3]),
+            ("LHipJoint", Some(0), [0.0; 3]),
+            ("LeftHip", Some(1), [1.25, -1.64, 0.72]),
+            ("LeftKnee", Some(2), [2.49, -6.85, 0.0]),
+            ("LeftAnkle", Some(3), [2.37, -6.51, 0.0]),
+            ("LeftToe", Some(4), [0.15, -0.41, 2.21]),
+            ("LeftToe_End", Some(5), [0.0, 0.0, 1.13]),
+        ]);
+        let tree = Tree::new(&s);
+        let leg = tree.limb(1, LimbKind::Leg).unwrap();
+        assert_eq!(leg.proximal.default, 2);
+        assert_eq!(leg.distal.default, 3);
+        assert_eq!(leg.extremity.default, 4);
+        assert_eq!(leg.tip.map(|t| t.default), Some(5));
+        assert_eq!(leg.proximal.joints, [2], "LHipJoint is at the hips, not at the hip");
+    }
+
+    #[test]
+    fn random_trees_never_panic() {
+        let mut rng = ChaCha8Rng::seed_from_u64(0x0b0d_1e5);
+        for _ in 0..300 {
+            let n = rng.gen_range(1..40);
+            let mut joints = vec![("j".to_owned(), None, [0.0; 3])];
+            for i in 1..n {
+                let offset = if rng.gen_bool(0.2) {
+                    [0.0; 3]
+                } else {
+                    std::array::from_fn(|_| rng.gen_range(-30.0..30.0))
+                };
+                joints.push((format!("j{i}"), Some(rng.gen_range(0..i)), offset));
+            }
+            let refs: Vec<(&str, Option<usize>, [f64; 3])> =
+                joints.iter().map(|(n, p, o)| (n.as_str(), *p, *o)).collect();
+            let tree = Tree::new(&skeleton(&refs));
+            if let Some(plan) = tree.body_plan() {
+                assert!(plan.trunk.first() == Some(&plan.pelvis));
+                assert!(plan.trunk.last() == Some(&plan.chest));
+            }
+        }
     }
 }

@@ -258,6 +258,21 @@ fn asf_style_in_millimetres() {
 }
 
 #[test]
+fn rigify_deform_bones_split_in_two_are_one_segment() {
+    let (_, h) = own("rigify_def_segments.bvh", UpAxis::PosY, 1.0, RestPose::ArmsDown);
+    let d = |s: &str, parts: [&str; 4]| parts.map(|p| format!("DEF-{p}.{s}"));
+    let names = (
+        ["spine", "spine.001", "spine.003", "spine.004", "spine.006"].map(|p| format!("DEF-{p}")),
+        [
+            d("L", ["shoulder", "upper_arm", "forearm", "hand"]),
+            d("R", ["shoulder", "upper_arm", "forearm", "hand"]),
+        ],
+        [d("L", ["thigh", "shin", "foot", "toe"]), d("R", ["thigh", "shin", "foot", "toe"])],
+    );
+    expect_owned(&h, "rigify", &names);
+}
+
+#[test]
 fn rokoko_with_fingers_and_face_joints() {
     let (_, h) = own("rokoko_fingers_face.bvh", UpAxis::PosY, 0.01, RestPose::ArmsDown);
     expect_owned(&h, "rokoko", &lafan_style("", "Spine3", "ToeBase"));

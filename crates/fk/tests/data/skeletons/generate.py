@@ -385,6 +385,46 @@ def mixamo(prefix="mixamorig_", fingers=False, prop=None):
     return joints, [prefix + "LeftLeg", prefix + "RightLeg"]
 
 
+def rigify_def():
+    # Blender Rigify deform bones: DEF- prefix, limbs split in two (thigh.L, thigh.L.001),
+    # pelvis side bones and breasts as extra chains.
+    joints = [("DEF-spine", None, "pelvis", "l")]
+    for s in "LR":
+        side = s.lower()
+        joints += [(f"DEF-pelvis.{s}", "DEF-spine", "pelvis", side),
+                   (None, f"DEF-pelvis.{s}", "pelvis:side", side)]
+        chain = [("thigh", "thigh"), ("thigh.001", "thigh:mid"), ("shin", "shin"),
+                 ("shin.001", "shin:mid"), ("foot", "foot"), ("toe", "toe")]
+        parent = "DEF-spine"
+        for bone, key in chain:
+            name = f"DEF-{bone.split('.')[0]}.{s}" + (".001" if "." in bone else "")
+            joints.append((name, parent, key, side))
+            parent = name
+        joints.append((None, parent, "toe_end", side))
+    spine = [("DEF-spine.001", "spine"), ("DEF-spine.002", "spine:2"),
+             ("DEF-spine.003", "chest"), ("DEF-spine.004", "neck"), ("DEF-spine.005", "neck:2"),
+             ("DEF-spine.006", "head")]
+    parent = "DEF-spine"
+    for name, key in spine:
+        joints.append((name, parent, key, "l"))
+        parent = name
+    joints.append((None, parent, "head_end", "l"))
+    for s in "LR":
+        side = s.lower()
+        chain = [("shoulder", "clavicle"), ("upper_arm", "upper_arm"),
+                 ("upper_arm.001", "upper_arm:mid"), ("forearm", "forearm"),
+                 ("forearm.001", "forearm:mid"), ("hand", "hand")]
+        parent = "DEF-spine.003"
+        for bone, key in chain:
+            name = f"DEF-{bone.split('.')[0]}.{s}" + (".001" if "." in bone else "")
+            joints.append((name, parent, key, side))
+            parent = name
+        joints.append((None, parent, "hand_end", side))
+        joints += [(f"DEF-breast.{s}", "DEF-spine.003", "chest:breast", side),
+                   (None, f"DEF-breast.{s}", "chest:nipple", side)]
+    return joints, ["DEF-shin.L", "DEF-shin.R"]
+
+
 def unrecognisable():
     # A robot arm: one chain, nothing like a body.
     joints = [("base", None, "pelvis", "l"), ("link1", "base", "spine", "l"),
@@ -406,6 +446,10 @@ EXTRA = {
     "hand:grip": (0.19, 0.86, 0.04), "hand:poletip": (0.19, 0.86, 1.54),
     "head:eye": (0.03, 1.66, 0.09), "head:eyetip": (0.03, 1.66, 0.10),
     "head:jaw": (0.0, 1.60, 0.05), "head:chin": (0.0, 1.56, 0.10),
+    "pelvis:side": (0.12, 0.95, 0.0), "thigh:mid": (0.09, 0.70, 0.005),
+    "shin:mid": (0.09, 0.285, -0.01), "upper_arm:mid": (0.185, 1.285, -0.005),
+    "forearm:mid": (0.19, 1.015, 0.005), "chest:breast": (0.1, 1.30, 0.08),
+    "chest:nipple": (0.1, 1.30, 0.12),
 }
 for k, v in EXTRA.items():
     BODY[k] = v
@@ -423,6 +467,7 @@ def main():
     write("unnamed_joints.bvh", joints, shins, yaw=130.0)
     write("mixamo_zero_pose_lying.bvh", *mixamo(), lying=True)
     write("mixamo_prop_in_hand.bvh", *mixamo(prefix="", fingers=True, prop="Object01"))
+    write("rigify_def_segments.bvh", *rigify_def(), unit=1.0)
     write("unrecognisable_chain.bvh", *unrecognisable())
 
 
