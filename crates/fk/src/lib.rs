@@ -293,7 +293,7 @@ fn units(
         positive("metres per unit", m)?;
         return Ok((m, format!("forced: {m} m per file unit")));
     }
-    if let Some(h) = humanoid {
+    if let Some(h) = humanoid.filter(|h| h.stature_path > 0.0) {
         return Ok(size::choose_units_from_stature(h.stature_path));
     }
     let parents: Vec<Option<usize>> = plan.parents().collect();

@@ -569,17 +569,30 @@ fn from_plan(tree: &Tree, names: &Names, plan: &BodyPlan, samples: &Samples) -> 
     (roles, sides)
 }
 
+/// How far above the leg junction (in thigh lengths) a joint named as the pelvis may be.
+const PELVIS_REACH: f64 = 0.5;
+
 /// Pelvis, spine, chest, neck and head along the trunk and the head chain.
 fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap) {
+    // Ancestors of the leg junction may be the pelvis by name (3ds Max Biped's legs hang on
+    // `Bip01 Spine`, below `Bip01 Pelvis`), if close to it: not a root on the floor.
+    let near = PELVIS_REACH * plan.legs[0].proximal_length;
     let mut above_pelvis: Vec<usize> = vec![plan.pelvis];
-    while let Some(p) = tree.parents[*above_pelvis.last().unwrap_or(&plan.pelvis)] {
+    let mut distance = 0.0;
+    let mut at = plan.pelvis;
+    while let Some(p) = tree.parents[at] {
+        distance += tree.length[at];
+        if distance > near {
+            break;
+        }
         above_pelvis.push(p);
+        at = p;
     }
     let pelvis = names.pick(
         Role::Pelvis,
         &above_pelvis,
         plan.pelvis,
-        "where the legs meet the trunk (or above it, by name)",
+        "where the legs meet the trunk (or just above it, by name)",
     );
     // 3ds Max Biped hangs the clavicles on the neck: the chest is then the joint below it.
     let arms_at = plan.chest;

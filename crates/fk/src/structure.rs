@@ -231,7 +231,7 @@ pub(crate) struct Run {
 }
 
 /// A limb read from the hierarchy.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Limb {
     pub(crate) path: Vec<usize>,
     /// Clavicle (arms only: on legs this bone has no role).
@@ -246,6 +246,8 @@ pub(crate) struct Limb {
     pub(crate) tip: Option<Run>,
     /// The end point after the extremity (toe joint or End Site), for the facing.
     pub(crate) extremity_end: Option<usize>,
+    /// Length of the first long bone (thigh, upper arm), file units.
+    pub(crate) proximal_length: f64,
     /// How the two long bones were found.
     pub(crate) reading: &'static str,
 }
@@ -306,6 +308,7 @@ impl Tree {
             extremity: run_forward(extremity_at),
             tip: tip_at.filter(|&i| !self.end_site[path[i]]).map(run_forward),
             extremity_end: tip_at.map(|i| path[i]),
+            proximal_length: bones[k].length,
             reading,
             path,
         })
@@ -507,7 +510,7 @@ mod tests {
 
     #[test]
     fn random_trees_never_panic() {
-        let mut rng = ChaCha8Rng::seed_from_u64(0x0b0d_1e5);
+        let mut rng = ChaCha8Rng::seed_from_u64(0x00b0_d1e5);
         for _ in 0..300 {
             let n = rng.gen_range(1..40);
             let mut joints = vec![("j".to_owned(), None, [0.0; 3])];

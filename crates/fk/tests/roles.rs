@@ -228,6 +228,17 @@ fn unreal_mannequin_ignores_twist_bones_and_ik_chains() {
 }
 
 #[test]
+fn a_root_on_the_floor_is_not_the_pelvis_even_by_name() {
+    // Unreal's `root` lies on the floor under `pelvis`; ASF calls its pelvis `root`. With the
+    // pelvis renamed, the name must not pull the pelvis role down to the floor.
+    let mut bvh = bvh::from_path(&skeleton("unreal_zup.bvh")).unwrap();
+    let pelvis = bvh.skeleton.find("pelvis").unwrap().0;
+    bvh.skeleton.joints[pelvis].name = "hip_centre".to_owned();
+    let h = fk::recognise(&bvh, &BTreeMap::new()).unwrap();
+    assert_eq!(h.roles.joint(Role::Pelvis), Some("hip_centre"));
+}
+
+#[test]
 fn smpl_in_metres_l_foot_is_the_toe() {
     let (_, h) = own("smpl_metres.bvh", UpAxis::PosY, 1.0, RestPose::TPose);
     expect(
