@@ -181,6 +181,15 @@ fn xsens_mvn_leftshoulder_is_the_upper_arm() {
 }
 
 #[test]
+fn cmu_motionbuilder_release_with_lhipjoint_lowerback_neck1() {
+    let (_, h) = own("cmu_motionbuilder.bvh", UpAxis::PosY, 0.01, RestPose::ArmsDown);
+    assert_eq!(h.convention, Some("CMU (MotionBuilder-friendly BVH)"));
+    let mut names = lafan_style("", "Spine1", "ToeBase");
+    names.0[1] = "LowerBack".to_owned();
+    expect_owned(&h, "cmu mb", &names);
+}
+
+#[test]
 fn biped_z_up_in_inches() {
     let (motion, h) = own("biped_zup_inches.bvh", UpAxis::PosZ, 0.0254, RestPose::ArmsDown);
     let b = |s: &str, parts: [&str; 4]| parts.map(|p| format!("Bip01 {s} {p}"));

@@ -425,6 +425,32 @@ def rigify_def():
     return joints, ["DEF-shin.L", "DEF-shin.R"]
 
 
+def cmu_motionbuilder():
+    # CMU's MotionBuilder-friendly release: LHipJoint on the hips, LowerBack, Neck1,
+    # LeftFingerBase and LThumb under the hand.
+    names = sided("{Side}{W}", {
+        "clavicle": "Shoulder", "upper_arm": "Arm", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase"})
+    joints = [("Hips", None, "pelvis", "l"), ("LowerBack", "Hips", "pelvis", "l"),
+              ("Spine", "LowerBack", "spine", "l"), ("Spine1", "Spine", "chest", "l"),
+              ("Neck", "Spine1", "neck", "l"), ("Neck1", "Neck", "neck:1", "l"),
+              ("Head", "Neck1", "head", "l"), (None, "Head", "head_end", "l")]
+    out = []
+    for j in limbs(names, "Hips", "Spine1", end_hand=False):
+        if j[0] in ("LeftUpLeg", "RightUpLeg"):
+            joint = f"{j[0][0]}HipJoint"
+            out += [(joint, "Hips", "pelvis", j[3]), (j[0], joint, "thigh", j[3])]
+        else:
+            out.append(j)
+    for side, s in (("Left", "l"), ("Right", "r")):
+        out += [(f"{side}FingerBase", f"{side}Hand", "hand_end", s),
+                (f"{side}HandIndex1", f"{side}FingerBase", "hand_end:2", s),
+                (None, f"{side}HandIndex1", "hand_end:tip", s),
+                (f"{side[0]}Thumb", f"{side}Hand", "hand_end:thumb", s),
+                (None, f"{side[0]}Thumb", "hand_end:thumbtip", s)]
+    return joints + out, ["LeftLeg", "RightLeg"]
+
+
 def unrecognisable():
     # A robot arm: one chain, nothing like a body.
     joints = [("base", None, "pelvis", "l"), ("link1", "base", "spine", "l"),
@@ -468,6 +494,7 @@ def main():
     write("mixamo_zero_pose_lying.bvh", *mixamo(), lying=True)
     write("mixamo_prop_in_hand.bvh", *mixamo(prefix="", fingers=True, prop="Object01"))
     write("rigify_def_segments.bvh", *rigify_def(), unit=1.0)
+    write("cmu_motionbuilder.bvh", *cmu_motionbuilder())
     write("unrecognisable_chain.bvh", *unrecognisable())
 
 
