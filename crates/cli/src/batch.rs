@@ -50,6 +50,8 @@ pub struct ClipResult {
     pub frames: usize,
     /// Quality metrics (the report's JSON), stored as is in the summary.
     pub metrics: serde_json::Value,
+    /// What was inferred about the source, one line (`fk::FkReport::inferred`).
+    pub inferred: Option<String>,
 }
 
 /// One row of `summary.json`.
@@ -69,6 +71,9 @@ pub struct ClipSummary {
     pub frames_per_second: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub metrics: Option<serde_json::Value>,
+    /// Up axis, unit, skeleton roles and rest pose inferred from the source.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub inferred: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub error: Option<String>,
 }
@@ -267,6 +272,7 @@ where
         seconds: None,
         frames_per_second: None,
         metrics: None,
+        inferred: None,
         error: None,
     };
     if output.is_file() && !plan.overwrite {
@@ -287,11 +293,13 @@ where
             row.seconds = Some(seconds);
             row.frames_per_second = Some(clip.frames as f64 / seconds.max(1e-9));
             row.metrics = Some(clip.metrics);
+            let inferred = clip.inferred.as_deref().map_or(String::new(), |i| format!("; {i}"));
             progress.clip_done(
                 &row.input,
-                &format!("{} frames in {seconds:.2} s", clip.frames),
+                &format!("{} frames in {seconds:.2} s{inferred}", clip.frames),
                 clip.frames,
             );
+            row.inferred = clip.inferred;
         }
         Err(err) => {
             row.status = "failed".to_string();
@@ -450,7 +458,11 @@ mod tests {
             bail!("{}: cannot convert", input.display());
         }
         crate::atomic_write(output, text.to_uppercase().as_bytes())?;
-        Ok(ClipResult { frames: text.len(), metrics: serde_json::json!({"len": text.len()}) })
+        Ok(ClipResult {
+            frames: text.len(),
+            metrics: serde_json::json!({"len": text.len()}),
+            inferred: None,
+        })
     }
 
     #[test]
@@ -492,6 +504,7 @@ mod tests {
             seconds: None,
             frames_per_second: None,
             metrics: None,
+            inferred: None,
             error: None,
         };
         let a = Summary {

@@ -88,10 +88,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
         robot: &robot,
         shard: args.shard,
     };
-    let summary = batch::run(&plan, |src: &Path, dst: &Path| {
-        let (frames, metrics) = job.convert_file(src, dst)?;
-        Ok(ClipResult { frames, metrics })
-    })?;
+    let summary = batch::run(&plan, |src: &Path, dst: &Path| job.convert_file(src, dst))?;
     print_table(&summary);
     eprintln!("batch: summary in {}", output.join(Summary::file_name(args.shard)).display());
     Ok(if summary.totals.failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
@@ -151,20 +148,24 @@ impl Job {
         })
     }
 
-    /// Retarget one file and write it; returns the frame count and the quality metrics.
-    fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<(usize, serde_json::Value)> {
+    /// Retarget one file and write it; returns the frame count, the quality metrics and
+    /// what was inferred about the source.
+    fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<ClipResult> {
         remove_stale_temporaries(dst);
         let bvh = bvh::from_path(src)?;
-        let (motion, _diag) =
-            retarget::retarget_bvh(&bvh, &self.model, &self.config, &self.options)
-                .with_context(|| format!("{}: retargeting", src.display()))?;
+        let (motion, diag) = retarget::retarget_bvh(&bvh, &self.model, &self.config, &self.options)
+            .with_context(|| format!("{}: retargeting", src.display()))?;
         let quality = retarget::report::report(
             &motion,
             &self.model,
             &retarget::report::ReportOptions::default(),
         )?;
         write_motion(dst, &motion, &self.model, Some(self.format))?;
-        Ok((motion.num_frames(), serde_json::to_value(&quality)?))
+        Ok(ClipResult {
+            frames: motion.num_frames(),
+            metrics: serde_json::to_value(&quality)?,
+            inferred: Some(diag.human_inferred),
+        })
     }
 }
 

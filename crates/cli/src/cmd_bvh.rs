@@ -27,11 +27,14 @@ pub enum BvhCommand {
     },
     /// World poses (m, Z up) of every body at one frame, plus units, subject height and ground.
     Fk(crate::cmd_bvh_fk::FkArgs),
+    /// Which joint plays each role (pelvis, left_thigh, …) and why; up axis, unit, rest pose.
+    Map(crate::cmd_bvh_map::MapArgs),
 }
 
 pub fn run(cmd: BvhCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         BvhCommand::Fk(args) => return crate::cmd_bvh_fk::run(&args),
+        BvhCommand::Map(args) => return crate::cmd_bvh_map::run(&args),
         BvhCommand::Info { file } => {
             let bvh = read_bvh(&file)?;
             let summary = bvh::Summary::new(&bvh, &file.display().to_string());

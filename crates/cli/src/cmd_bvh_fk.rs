@@ -20,8 +20,8 @@ pub struct FkArgs {
     /// File units: auto, m, cm, mm, inch, cmu, or metres per unit as a number.
     #[arg(long, default_value = "auto", value_parser = parse_units)]
     pub units: UnitChoice,
-    /// Which way is up in the file.
-    #[arg(long, value_enum, default_value_t = Axes::YUp)]
+    /// Which way is up in the file (auto: the axis the head is above the feet along).
+    #[arg(long, value_enum, default_value_t = Axes::Auto)]
     pub axes: Axes,
     /// Subject height in metres instead of the estimate.
     #[arg(long)]
@@ -31,6 +31,8 @@ pub struct FkArgs {
 /// `--axes` values (see `fk::AxisConvention`).
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Axes {
+    /// Inferred from the motion (Y up converted as GMR does).
+    Auto,
     /// Y up, as GMR: +90° about X (a subject facing file +Z faces world −Y).
     YUp,
     /// Already Z up.
@@ -43,6 +45,7 @@ impl FkArgs {
     #[must_use]
     pub fn options(&self) -> FkOptions {
         let axes = match self.axes {
+            Axes::Auto => AxisConvention::Auto,
             Axes::YUp => AxisConvention::YUp,
             Axes::ZUp => AxisConvention::ZUp,
             Axes::YUpFaceX => AxisConvention::YUpFaceX,

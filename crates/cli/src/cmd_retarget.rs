@@ -291,6 +291,9 @@ fn print_summary(
         diag.human_height,
         diag.human_height_source
     );
+    if !diag.human_inferred.is_empty() {
+        println!("inferred: {}", diag.human_inferred);
+    }
     println!(
         "solved in {wall:.3} s wall ({:.0} frames/s overall, IK {:.0} frames/s)",
         frames as f64 / wall.max(1e-9),

@@ -7,6 +7,7 @@ mod batch;
 mod cmd_batch;
 mod cmd_bvh;
 mod cmd_bvh_fk;
+mod cmd_bvh_map;
 mod cmd_c3d;
 mod cmd_report;
 mod cmd_retarget;

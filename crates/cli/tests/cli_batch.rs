@@ -110,6 +110,11 @@ fn batch_isolates_failures_and_resumes_after_kills_with_identical_outputs() {
             .unwrap();
     assert_eq!(summary["totals"]["converted"], 5);
     assert_eq!(summary["totals"]["frames"], 5 * 240);
+    let rows = summary["clips"].as_array().unwrap();
+    for row in rows.iter().filter(|r| r["status"] == "converted") {
+        let inferred = row["inferred"].as_str().unwrap_or_default();
+        assert!(inferred.starts_with("+Y up, centimetres"), "{row}");
+    }
     let want = outputs(&reference);
     assert_eq!(want.len(), 5, "{:?}", want.iter().map(|f| &f.0).collect::<Vec<_>>());
 

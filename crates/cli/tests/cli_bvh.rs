@@ -143,3 +143,74 @@ fn warnings_go_to_stderr_one_line_each_prefixed_by_the_file() {
     let (_, warnings) = bvh::parse_with_warnings(&out.stdout).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
 }
+
+fn skeleton(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fk/tests/data/skeletons").join(name)
+}
+
+#[test]
+fn map_prints_roles_conventions_and_rules() {
+    let file = skeleton("biped_zup_inches.bvh");
+    let out = retarget(&["bvh".as_ref(), "map".as_ref(), file.as_os_str()]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("skeleton:   21 roles; names: 3ds Max Biped\n"), "{stdout}");
+    assert!(stdout.contains("up axis:    +Z ("), "{stdout}");
+    assert!(stdout.contains("unit:       0.0254 m per file unit (inches"), "{stdout}");
+    assert!(stdout.contains("rest pose:  arms down"), "{stdout}");
+    let row = stdout.lines().find(|l| l.starts_with("left_shin ")).unwrap();
+    assert!(row.contains("Bip01 L Calf") && row.contains("name (3ds Max Biped)"), "{row}");
+}
+
+#[test]
+fn map_overrides_roles_from_json_and_reports_bad_maps() {
+    let dir = temp_dir("map");
+    let map = dir.join("map.json");
+    std::fs::write(&map, r#"{"spine": "joint6", "left_hand": "joint16_End"}"#).unwrap();
+    let file = skeleton("unnamed_joints.bvh");
+    let args = |m: &std::path::Path| {
+        retarget(&[
+            "bvh".as_ref(),
+            "map".as_ref(),
+            file.as_os_str(),
+            "--map".as_ref(),
+            m.as_os_str(),
+        ])
+    };
+    let out = args(&map);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("names: none recognised (hierarchy alone)"), "{stdout}");
+    let row = |role: &str| stdout.lines().find(|l| l.starts_with(role)).unwrap().to_owned();
+    assert!(row("spine ").contains("joint6") && row("spine ").ends_with("given"), "{stdout}");
+    assert!(row("left_hand ").contains("joint16_End"), "{stdout}");
+    assert!(row("right_hand ").contains("joint12") && row("right_hand ").contains("hierarchy"));
+
+    std::fs::write(&map, r#"{"left_wing": "joint3"}"#).unwrap();
+    let out = args(&map);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("unknown role `left_wing`; roles: pelvis, spine"),
+        "{}",
+        text(&out.stderr)
+    );
+    std::fs::write(&map, r#"{"head": "Skull"}"#).unwrap();
+    let out = args(&map);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("role head is given as joint `Skull`"),
+        "{}",
+        text(&out.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn map_of_an_unrecognisable_skeleton_says_what_is_missing() {
+    let file = skeleton("unrecognisable_chain.bvh");
+    let out = retarget(&["bvh".as_ref(), "map".as_ref(), file.as_os_str()]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("not recognised as a humanoid skeleton"), "{stderr}");
+    assert!(stderr.contains("left_thigh: a joint named e.g. LeftUpLeg"), "{stderr}");
+}

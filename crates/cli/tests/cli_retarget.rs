@@ -49,6 +49,12 @@ fn writes_npz_next_to_the_input_and_prints_a_summary() {
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
     assert!(stdout.contains("40 frames at 30.000 fps"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "inferred: +Y up, centimetres (0.01 m/unit), 21 roles by LAFAN1 / Mixamo / HumanIK"
+        ),
+        "{stdout}"
+    );
     assert!(stdout.contains("left_ankle_roll_link"), "{stdout}");
     assert!(stdout.contains("joint limits:"), "{stdout}");
     let npz = dir.join("walk.npz");

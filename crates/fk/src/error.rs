@@ -38,4 +38,28 @@ pub enum Error {
     /// A scale or height option that is zero, negative or not finite.
     #[error("invalid option {name} = {value}: must be a positive finite number")]
     InvalidOption { name: &'static str, value: f64 },
+    /// The skeleton is not recognised as a humanoid: required roles no joint plays.
+    #[error("{}", unrecognised(missing, *found))]
+    Unrecognised { missing: Vec<crate::Role>, found: usize },
+    /// A role given by joint name (`FkOptions::roles`, `--map`) names no joint.
+    #[error("role {role} is given as joint `{name}`, which the skeleton does not have")]
+    UnknownRoleJoint { role: crate::Role, name: String },
+}
+
+/// The message of [`Error::Unrecognised`]: each missing role with names we accept for it.
+fn unrecognised(missing: &[crate::Role], found: usize) -> String {
+    let roles: Vec<String> = missing
+        .iter()
+        .map(|role| {
+            let names = crate::conventions::examples(*role);
+            let shown = names.iter().take(8).map(String::as_str).collect::<Vec<_>>().join(", ");
+            format!("  {role}: a joint named e.g. {shown}")
+        })
+        .collect();
+    format!(
+        "not recognised as a humanoid skeleton ({found} roles found); missing:\n{}\n\
+         name the joints as one of the conventions does, or map the roles to joints \
+         explicitly (role -> joint name)",
+        roles.join("\n")
+    )
 }

@@ -24,19 +24,29 @@
 //!
 //! `fk` does no IO, never prints and never panics on input.
 
+pub mod conventions;
 mod error;
 mod forward;
+pub mod frames;
 pub mod markers;
 mod math;
 mod motion;
 mod options;
+mod roles;
 mod size;
+mod structure;
 mod trig;
 
 pub use error::Error;
 pub use forward::{PositionChannels, PositionReading};
+pub use frames::canonical_frames;
 pub use motion::HumanMotion;
 pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
+pub use roles::{
+    Humanoid, Part, Reference, RestPose, Role, RoleJoint, RoleMap, Rule, Side, UpAxis,
+};
+
+use std::collections::BTreeMap;
 
 use bvh::Bvh;
 use nalgebra::Vector3;
@@ -59,6 +69,84 @@ pub struct FkReport {
     pub ground: f64,
     /// How each joint with position channels was read, in joint order ([`PositionReading`]).
     pub position_channels: Vec<PositionChannels>,
+    /// The file-to-world rotation that was applied (never [`AxisConvention::Auto`]).
+    pub axes: AxisConvention,
+    /// Why those axes (inferred up axis and the evidence, or "given").
+    pub axes_reason: String,
+    /// The recognised humanoid (roles, up axis, rest pose, body frames), or why the skeleton
+    /// was not recognised (FK works on any skeleton; only the conventions fall back).
+    pub humanoid: Result<Humanoid, Error>,
+}
+
+impl FkReport {
+    /// One line on what was inferred: up axis, unit, naming convention, rest pose.
+    #[must_use]
+    pub fn inferred(&self) -> String {
+        let unit = self.unit_reason.split(':').next().unwrap_or("").trim();
+        let up = match (&self.humanoid, self.axes_reason.as_str()) {
+            (_, "given") => "axes given".to_owned(),
+            (Ok(h), _) => format!("{} up", h.up),
+            (Err(_), _) => "+Y up assumed".to_owned(),
+        };
+        match &self.humanoid {
+            Ok(h) => format!(
+                "{up}, {unit} ({} m/unit), {} roles by {}, rest pose {}",
+                self.metres_per_unit,
+                h.roles.len(),
+                h.convention.unwrap_or("hierarchy alone"),
+                h.rest_pose
+            ),
+            Err(_) => {
+                format!(
+                    "{up}, {unit} ({} m/unit), skeleton not recognised as a humanoid",
+                    self.metres_per_unit
+                )
+            }
+        }
+    }
+}
+
+/// Recognise the humanoid in `bvh`: which joint plays each [`Role`] and by which rule, the
+/// up axis, the rest-pose kind and the body frames ([`Humanoid`]). `given` fixes roles by
+/// joint name. An unrecognised skeleton is an [`Error::Unrecognised`] that lists the missing
+/// roles and names that would be recognised.
+pub fn recognise(bvh: &Bvh, given: &BTreeMap<Role, String>) -> Result<Humanoid, Error> {
+    let plan = Plan::new(bvh)?;
+    check_finite(bvh)?;
+    roles::recognise(&bvh.skeleton, &samples(&plan, bvh), given)
+}
+
+/// At most this many frames of a clip are looked at to recognise the humanoid.
+const SAMPLED_FRAMES: usize = 128;
+
+/// The zero pose and evenly spaced frames, in file axes and units.
+fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
+    let file = ToWorld::new(&AxisConvention::ZUp, 1.0);
+    let n = bvh.motion.num_frames;
+    let count = n.min(SAMPLED_FRAMES);
+    let picked: Vec<usize> =
+        (0..count).map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 }).collect();
+    let motion = &bvh.motion;
+    let sub = Bvh {
+        skeleton: bvh.skeleton.clone(),
+        motion: bvh::Motion {
+            frame_time: motion.frame_time,
+            num_frames: picked.len(),
+            num_channels: motion.num_channels,
+            values: picked.iter().flat_map(|&f| motion.frame(f).iter().copied()).collect(),
+        },
+    };
+    let (positions, orientations) = forward::run(plan, &sub, &file, &[]);
+    let joints = plan.num_joints();
+    let frames = picked
+        .iter()
+        .enumerate()
+        .map(|(k, &f)| {
+            let range = k * joints..(k + 1) * joints;
+            (f, positions[range.clone()].to_vec(), orientations[range].to_vec())
+        })
+        .collect();
+    roles::Samples { rest: rest_pose(plan, &file), frames }
 }
 
 /// Forward kinematics of every frame of `bvh`, converted to our world (see [`FkOptions`]).
@@ -68,12 +156,25 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     check_finite(bvh)?;
     let joint_names: Vec<String> = bvh.skeleton.joints.iter().map(|j| j.name.clone()).collect();
     let derived = resolve_derived(&joint_names, &options.derived)?;
-    let (metres_per_unit, unit_reason) = units(&plan, options.units)?;
+    let humanoid = match roles::recognise(&bvh.skeleton, &samples(&plan, bvh), &options.roles) {
+        Err(e @ Error::UnknownRoleJoint { .. }) => return Err(e),
+        other => other,
+    };
+    let (axes, axes_reason) = match (options.axes, &humanoid) {
+        (AxisConvention::Auto, Ok(h)) => {
+            (h.up.convention(), format!("{} up: {}", h.up, h.up_reason))
+        }
+        (AxisConvention::Auto, Err(_)) => {
+            (AxisConvention::YUp, "+Y up assumed (the BVH norm): no humanoid recognised".to_owned())
+        }
+        (given, _) => (given, "given".to_owned()),
+    };
+    let (metres_per_unit, unit_reason) = units(&plan, options.units, humanoid.as_ref().ok())?;
     if let Some(h) = options.height {
         positive("height", h)?;
     }
 
-    let world = ToWorld::new(&options.axes, metres_per_unit);
+    let world = ToWorld::new(&axes, metres_per_unit);
     let num_frames = bvh.motion.num_frames;
     let num_joints = plan.num_joints();
     let sources: Vec<(usize, usize)> =
@@ -81,7 +182,10 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     let (positions, orientations) = forward::run(&plan, bvh, &world, &sources);
     let mut body_names = joint_names;
     body_names.extend(derived.into_iter().map(|d| d.name));
-    let landmarks = Landmarks::find(&bvh.skeleton, metres_per_unit);
+    let landmarks = match &humanoid {
+        Ok(h) => Landmarks::from_roles(&bvh.skeleton, metres_per_unit, &h.roles),
+        Err(_) => Landmarks::find(&bvh.skeleton, metres_per_unit),
+    };
     let rest = rest_pose(&plan, &world);
     let motion = HumanMotion { fps, body_names, num_frames, positions, orientations };
     let frames = (0..num_frames).map(|f| &motion.frame_positions(f)[..num_joints]);
@@ -98,6 +202,9 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
         height_source,
         ground: stature.ground,
         position_channels,
+        axes,
+        axes_reason,
+        humanoid,
     };
     Ok((motion, report))
 }
@@ -178,13 +285,21 @@ fn resolve_derived(joints: &[String], requested: &[DerivedBody]) -> Result<Vec<D
     Ok(out)
 }
 
-/// Metres per file unit: forced, or chosen from the skeleton's size. Bone lengths are the
-/// OFFSETs, except those of the roots' children: in some files (Bandai) the root sits on the
-/// floor and that OFFSET is the hip height, not a bone.
-fn units(plan: &Plan, choice: UnitChoice) -> Result<(f64, String), Error> {
+/// Metres per file unit: forced, or chosen from the body's proportions (a recognised
+/// humanoid's head-to-ankle bone path), or else from the skeleton's size. Bone lengths are
+/// the OFFSETs, except those of the roots' children: in some files (Bandai) the root sits on
+/// the floor and that OFFSET is the hip height, not a bone.
+fn units(
+    plan: &Plan,
+    choice: UnitChoice,
+    humanoid: Option<&Humanoid>,
+) -> Result<(f64, String), Error> {
     if let UnitChoice::Scale(m) = choice {
         positive("metres per unit", m)?;
         return Ok((m, format!("forced: {m} m per file unit")));
+    }
+    if let Some(h) = humanoid.filter(|h| h.stature_path > 0.0) {
+        return Ok(size::choose_units_from_stature(h.stature_path));
     }
     let parents: Vec<Option<usize>> = plan.parents().collect();
     let lengths: Vec<f64> = plan

@@ -1,15 +1,24 @@
 //! The knobs of [`crate::human_motion`], with defaults that reproduce GMR's LAFAN1 loader.
 
+use std::collections::BTreeMap;
+
 use nalgebra::{Matrix3, UnitQuaternion};
+
+use crate::Role;
 
 /// Which way is up (and forward) in the source file; fixes the proper rotation from file axes
 /// to our world (Z up). Every variant is a rotation (determinant +1): a reflection would
 /// silently mirror the motion, turning left feet into right ones.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum AxisConvention {
+    /// Inferred from the motion: the file axis along which the head is above the feet
+    /// ([`crate::Humanoid::up`]), converted as [`AxisConvention::YUp`] for +Y and
+    /// [`AxisConvention::ZUp`] for +Z. When no humanoid is recognised, [`AxisConvention::YUp`]
+    /// (the BVH norm), which is also what the matrix and quaternion of `Auto` are.
+    #[default]
+    Auto,
     /// Y up (the BVH norm, LAFAN1, CMU, Bandai): +90° about X, `(x, y, z) ↦ (x, −z, y)`.
     /// This is GMR's conversion; a subject facing file +Z faces world −Y.
-    #[default]
     YUp,
     /// The file is already Z up: identity.
     ZUp,
@@ -26,7 +35,9 @@ impl AxisConvention {
     #[must_use]
     pub fn world_from_file_matrix(&self) -> Matrix3<f64> {
         match self {
-            AxisConvention::YUp => Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0),
+            AxisConvention::Auto | AxisConvention::YUp => {
+                Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
+            }
             AxisConvention::ZUp => Matrix3::identity(),
             AxisConvention::YUpFaceX => Matrix3::new(0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0),
             AxisConvention::Custom(q) => q.to_rotation_matrix().into_inner(),
@@ -41,7 +52,7 @@ impl AxisConvention {
             AxisConvention::Custom(q) => *q,
             // scipy's from_matrix on an exact matrix: (2, 2, 0, 0) / ‖·‖, which is one ulp
             // below FRAC_1_SQRT_2; spelled out so the parity with GMR is exact.
-            AxisConvention::YUp => {
+            AxisConvention::Auto | AxisConvention::YUp => {
                 let h = 2.0 / 8.0_f64.sqrt();
                 UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(h, h, 0.0, 0.0))
             }
@@ -109,6 +120,8 @@ pub struct FkOptions {
     pub derived: Vec<DerivedBody>,
     /// Subject height in metres; `None` estimates it from the motion (see [`crate::FkReport`]).
     pub height: Option<f64>,
+    /// Roles fixed by joint name, overriding the recogniser ([`crate::recognise`]).
+    pub roles: BTreeMap<Role, String>,
 }
 
 impl Default for FkOptions {
@@ -118,6 +131,7 @@ impl Default for FkOptions {
             units: UnitChoice::default(),
             derived: DerivedBody::gmr_defaults(),
             height: None,
+            roles: BTreeMap::new(),
         }
     }
 }

@@ -10,10 +10,15 @@ const CANDIDATES: [(f64, &str); 5] = [
     (0.05644, "CMU units (3ds Max-friendly release, mocap.cs.cmu.edu FAQ)"),
 ];
 
-/// Stature proxy range (metres) a candidate must land in; see [`choose_units`].
-const PROXY_RANGE: (f64, f64) = (1.0, 2.6);
-/// Typical value of the proxy for an adult (a 1.75 m subject's span or head-to-toe path).
-const PROXY_TYPICAL: f64 = 1.8;
+/// A length that tracks stature, the human range it must land in (metres) and its typical
+/// value for an adult.
+#[derive(Debug, Clone, Copy)]
+struct Proxy {
+    value: f64,
+    range: (f64, f64),
+    typical: f64,
+    what: &'static str,
+}
 
 /// The longest path between two joints along the bones (sum of bone lengths, file units):
 /// head-to-toe or fingertip-to-fingertip, which both track stature (arm span ≈ height) in
@@ -39,24 +44,44 @@ pub(crate) fn tree_diameter(parents: &[Option<usize>], lengths: &[f64]) -> f64 {
     best_two.iter().map(|[a, b]| a + b).fold(0.0, f64::max)
 }
 
-/// Pick metres per file unit from the stature proxy `diameter` (file units): the candidate
-/// whose result is closest (in ratio) to a typical adult, among those in a human range. If
-/// none fits, a computed scale making the proxy typical. Returns the scale and the reason.
+/// Metres per file unit for a skeleton of unknown shape, from its [`tree_diameter`] (1.8 m
+/// typical, 1.0–2.6 m human): fingers and props count, so this is the fallback.
 #[must_use]
 pub(crate) fn choose_units(diameter: f64) -> (f64, String) {
-    let ratio = |m: f64| ((diameter * m) / PROXY_TYPICAL).ln().abs();
+    choose(Proxy {
+        value: diameter,
+        range: (1.0, 2.6),
+        typical: 1.8,
+        what: "longest bone path (head-to-toe / arm span)",
+    })
+}
+
+/// Metres per file unit for a recognised humanoid, from its stature path (head joint →
+/// pelvis → ankle along the bones, [`crate::Humanoid::stature_path`]): ≈ 0.95 of stature,
+/// 1.6 m typical, 0.8–2.4 m human; fingers, face and props do not count.
+#[must_use]
+pub(crate) fn choose_units_from_stature(path: f64) -> (f64, String) {
+    choose(Proxy { value: path, range: (0.8, 2.4), typical: 1.6, what: "head-to-ankle bone path" })
+}
+
+/// The candidate whose result is closest (in ratio) to the typical value, among those in the
+/// human range. If none fits, a computed scale making the proxy typical. Returns the scale
+/// and the reason.
+fn choose(proxy: Proxy) -> (f64, String) {
+    let Proxy { value, range, typical, what } = proxy;
+    let ratio = |m: f64| ((value * m) / typical).ln().abs();
     let best = CANDIDATES
         .iter()
-        .filter(|(m, _)| (PROXY_RANGE.0..=PROXY_RANGE.1).contains(&(diameter * m)))
+        .filter(|(m, _)| (range.0..=range.1).contains(&(value * m)))
         .min_by(|a, b| ratio(a.0).total_cmp(&ratio(b.0)));
-    let proxy = format!("longest bone path (head-to-toe / arm span) {diameter:.4} file units");
+    let proxy = format!("{what} {value:.4} file units");
     match best {
         Some(&(m, name)) => {
-            (m, format!("{name}: {proxy} is {:.2} m at {m} m/unit, a human size", diameter * m))
+            (m, format!("{name}: {proxy} is {:.2} m at {m} m/unit, a human size", value * m))
         }
-        None if diameter.is_finite() && diameter > 0.0 => {
-            let m = PROXY_TYPICAL / diameter;
-            (m, format!("computed: {proxy} fits no known unit; scaled to {PROXY_TYPICAL} m"))
+        None if value.is_finite() && value > 0.0 => {
+            let m = typical / value;
+            (m, format!("computed: {proxy} fits no known unit; scaled to {typical} m"))
         }
         None => (1.0, format!("metres (assumed): {proxy} gives no size to go by")),
     }
@@ -89,6 +114,45 @@ impl Landmarks {
             skeleton.joints.iter().map(|j| j.parent.map(|p| p.0)).collect();
         let head = subtree_of(&names, &parents, &["head"]);
         let feet = subtree_of(&names, &parents, &["foot", "toe", "ankle"]);
+        Landmarks::new(skeleton, metres_per_unit, head, feet)
+    }
+
+    /// Head: the head role's joint and its descendants; feet: the foot and toe roles' joints
+    /// and their descendants (for a recognised [`crate::Humanoid`], whatever the names).
+    pub(crate) fn from_roles(
+        skeleton: &bvh::Skeleton,
+        metres_per_unit: f64,
+        roles: &crate::RoleMap,
+    ) -> Landmarks {
+        use crate::Part;
+        let n = skeleton.joints.len();
+        let mut head = vec![false; n];
+        let mut feet = vec![false; n];
+        for (role, joint) in roles.iter() {
+            match role.part() {
+                Part::Head => head[joint.index] = true,
+                Part::Foot | Part::Toe => feet[joint.index] = true,
+                _ => {}
+            }
+        }
+        for (i, joint) in skeleton.joints.iter().enumerate() {
+            if let Some(p) = joint.parent {
+                head[i] |= head[p.0];
+                feet[i] |= feet[p.0];
+            }
+        }
+        let pick = |marks: Vec<bool>| (0..n).filter(|&i| marks[i]).collect();
+        Landmarks::new(skeleton, metres_per_unit, pick(head), pick(feet))
+    }
+
+    fn new(
+        skeleton: &bvh::Skeleton,
+        metres_per_unit: f64,
+        head: Vec<usize>,
+        feet: Vec<usize>,
+    ) -> Landmarks {
+        let names: Vec<String> =
+            skeleton.joints.iter().map(|j| j.name.to_ascii_lowercase()).collect();
         let all: Vec<usize> = (0..names.len()).collect();
         let head_top = head.is_empty()
             || head.iter().any(|&i| {

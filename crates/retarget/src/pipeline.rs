@@ -137,6 +137,9 @@ pub struct ClipDiagnostics {
     /// Subject height used for scaling (m) and where it came from.
     pub human_height: f64,
     pub human_height_source: String,
+    /// What FK inferred about the source, in one line ([`fk::FkReport::inferred`]: up axis,
+    /// unit, skeleton roles, rest pose); empty when a `HumanMotion` was given directly.
+    pub human_inferred: String,
     /// Wall time of the IK alone (seconds).
     pub solve_seconds: f64,
 }
@@ -197,6 +200,7 @@ pub fn retarget_bvh(
         }
         None => retarget_motion(&human, model, config, &opts)?,
     };
+    diag.human_inferred = report.inferred();
     diag.human_height_source = report.height_source;
     Ok((motion, diag))
 }
@@ -422,6 +426,7 @@ impl<'a> Prepared<'a> {
             frames,
             human_height: self.height,
             human_height_source: "given".to_owned(),
+            human_inferred: String::new(),
             solve_seconds,
         };
         (motion, diag)

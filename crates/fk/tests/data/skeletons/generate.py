@@ -1,0 +1,502 @@
+#!/usr/bin/env python3
+"""Writes the small BVH skeletons of `crates/fk/tests/roles.rs` (run from this folder).
+
+One body, described once in body coordinates (metres; x = the subject's left, y = up,
+z = forward), is written in several naming conventions, hierarchies, units, up axes and rest
+poses. Every file has four frames: the subject walks forward, turns a little and bends both
+knees, so that the motion shows which way it faces. Pure Python, no dependencies.
+"""
+
+import math
+
+# Joint positions of the left side and the trunk, standing with the arms down.
+BODY = {
+    "pelvis": (0.0, 0.95, 0.0),
+    "spine": (0.0, 1.05, -0.01),
+    "chest": (0.0, 1.28, 0.0),
+    "neck": (0.0, 1.48, 0.0),
+    "head": (0.0, 1.60, 0.02),
+    "head_end": (0.0, 1.75, 0.02),
+    "clavicle": (0.02, 1.44, 0.04),
+    "upper_arm": (0.18, 1.43, 0.0),
+    "forearm": (0.19, 1.14, -0.01),
+    "hand": (0.19, 0.89, 0.02),
+    "hand_end": (0.19, 0.80, 0.03),
+    "thigh": (0.09, 0.91, 0.0),
+    "shin": (0.09, 0.49, 0.01),
+    "foot": (0.09, 0.08, -0.03),
+    "toe": (0.09, 0.02, 0.10),
+    "toe_end": (0.09, 0.01, 0.16),
+}
+
+ARMS = {
+    "down": None,
+    "t": {"forearm": (0.48, 1.43, 0.0), "hand": (0.74, 1.43, 0.0), "hand_end": (0.83, 1.43, 0.0)},
+    "a": {
+        "forearm": (0.18 + 0.212, 1.43 - 0.212, 0.0),
+        "hand": (0.392 + 0.184, 1.218 - 0.184, 0.0),
+        "hand_end": (0.576 + 0.064, 1.034 - 0.064, 0.0),
+    },
+}
+
+
+def point(key, side="l", arms="down"):
+    """Body point `key` on `side` ('l' or 'r'; ignored for the trunk). Extra points near a
+    hand (`hand_end:tip`) move with the arm pose."""
+    base = key.split(":")[0]
+    p = BODY[key]
+    if ARMS[arms] and base in ARMS[arms]:
+        p = add(ARMS[arms][base], sub(p, BODY[base]))
+    return (-p[0], p[1], p[2]) if side == "r" else p
+
+
+def add(a, b):
+    return tuple(x + y for x, y in zip(a, b))
+
+
+def sub(a, b):
+    return tuple(x - y for x, y in zip(a, b))
+
+
+def mat_vec(m, v):
+    return tuple(sum(m[i][k] * v[k] for k in range(3)) for i in range(3))
+
+
+def mat_mul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def transpose(m):
+    return [[m[j][i] for j in range(3)] for i in range(3)]
+
+
+def rot(axis, degrees):
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+    return {
+        "x": [[1, 0, 0], [0, c, -s], [0, s, c]],
+        "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
+        "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]],
+    }[axis]
+
+
+def euler_zxy(m):
+    """Degrees (z, x, y) with m = Rz · Rx · Ry (channels `Zrotation Xrotation Yrotation`)."""
+    x = math.asin(max(-1.0, min(1.0, m[2][1])))
+    z = math.atan2(-m[0][1], m[1][1])
+    y = math.atan2(-m[2][0], m[2][2])
+    return tuple(math.degrees(v) for v in (z, x, y))
+
+
+# Body → file axes: columns are where the body's left, up and forward go.
+Y_UP = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]  # BVH norm: facing +Z, left = +X
+Z_UP_FACE_Y = [[-1, 0, 0], [0, 0, 1], [0, 1, 0]]  # 3ds Max / Unreal: up +Z, facing +Y
+
+
+def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying=False):
+    """`joints`: (name, parent or None, body point key, side); End Sites are named None and
+    placed at their point. `shins`: names of the joints that bend as knees."""
+    axes = mat_mul(rot("y", 0) if axes is None else axes, rot("y", yaw))
+    # A zero pose lying on its back along +X: offsets turned by r0, undone by the root.
+    r0 = rot("z", -90) if lying else rot("x", 0)
+    pos = {}
+    for name, parent, key, side in joints:
+        pos[(name, parent)] = point(key, side, arms)
+    lines = ["HIERARCHY"]
+    children = {}
+    for j in joints:
+        children.setdefault(j[1], []).append(j)
+    order = []
+
+    def emit(joint, depth, parent_point):
+        name, parent, key, side = joint
+        p = pos[(name, parent)]
+        offset = p if parent is None else sub(p, parent_point)
+        offset = mat_vec(axes, offset)
+        if parent is not None:
+            offset = mat_vec(r0, offset)
+        offset = tuple(v / unit for v in offset)
+        pad = "  " * depth
+        if name is None:
+            lines.append(f"{pad}End Site")
+        else:
+            lines.append(f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}")
+        lines.append(pad + "{")
+        lines.append(pad + "  OFFSET " + " ".join(f"{v:.6f}" for v in offset))
+        if name is not None:
+            if parent is None:
+                chans = "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
+            else:
+                chans = "3 Zrotation Xrotation Yrotation"
+            lines.append(pad + "  CHANNELS " + chans)
+            order.append(name)
+            for child in children.get(name, []):
+                emit(child, depth + 1, p)
+        lines.append(pad + "}")
+
+    emit(children[None][0], 0, None)
+    rows = []
+    for k in range(4):
+        row = []
+        for name in order:
+            if name == order[0]:
+                root = add(point(joints[0][2]), (0.0, 0.0, 0.1 * k))
+                row += [v / unit for v in mat_vec(axes, root)]
+                turn = mat_mul(mat_mul(axes, rot("y", 5.0 * k)), transpose(axes))
+                row += euler_zxy(mat_mul(turn, transpose(r0)))
+            elif name in shins:
+                bend = mat_mul(mat_mul(axes, rot("x", 10.0 + 8.0 * k)), transpose(axes))
+                row += euler_zxy(mat_mul(mat_mul(r0, bend), transpose(r0)))
+            else:
+                row += [0.0, 0.0, 0.0]
+        rows.append(" ".join(f"{v:.6f}" for v in row))
+    lines += ["MOTION", f"Frames: {len(rows)}", "Frame Time: 0.033333"] + rows
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def limbs(names, trunk_parent_leg, trunk_parent_arm, sides=("l", "r"), end_hand=True,
+          end_toe=True, twist=None):
+    """Arms and legs from `names[(part, side)]` (None: no such joint)."""
+    out = []
+    for s in sides:
+        chain = [(p, names.get((p, s))) for p in ("clavicle", "upper_arm", "forearm", "hand")]
+        parent = trunk_parent_arm
+        for part, name in chain:
+            if name:
+                out.append((name, parent, part, s))
+                parent = name
+        if end_hand:
+            out.append((None, parent, "hand_end", s))
+    for s in sides:
+        parent = trunk_parent_leg
+        for part in ("thigh", "shin", "foot", "toe"):
+            name = names.get((part, s))
+            if name:
+                out.append((name, parent, part, s))
+                parent = name
+        if end_toe:
+            out.append((None, parent, "toe_end", s))
+    return out
+
+
+def sided(pattern, parts):
+    """{(part, side): pattern with {S} → L/R, {s} → l/r, {Side} → Left/Right, {side}}."""
+    out = {}
+    for part, word in parts.items():
+        for s in ("l", "r"):
+            out[(part, s)] = (
+                pattern.replace("{W}", word)
+                .replace("{S}", s.upper())
+                .replace("{s}", s)
+                .replace("{Side}", "Left" if s == "l" else "Right")
+                .replace("{side}", "left" if s == "l" else "right")
+            )
+    return out
+
+
+def trunk(names, keys=("pelvis", "spine", "chest", "neck", "head")):
+    out = []
+    parent = None
+    for key, name in zip(keys, names):
+        out.append((name, parent, key, "l"))
+        parent = name
+    out.append((None, parent, "head_end", "l"))
+    return out
+
+
+def xsens():
+    # MVN's BVH export: Hips, Chest…Chest4, LeftCollar, LeftShoulder = upper arm, LeftHip.
+    names = sided("{Side}{W}", {
+        "clavicle": "Collar", "upper_arm": "Shoulder", "forearm": "Elbow", "hand": "Wrist",
+        "thigh": "Hip", "shin": "Knee", "foot": "Ankle", "toe": "Toe"})
+    joints = [("Hips", None, "pelvis", "l"), ("Chest", "Hips", "spine", "l"),
+              ("Chest2", "Chest", "spine:2", "l"), ("Chest3", "Chest2", "spine:3", "l"),
+              ("Chest4", "Chest3", "chest", "l"), ("Neck", "Chest4", "neck", "l"),
+              ("Head", "Neck", "head", "l"), (None, "Head", "head_end", "l")]
+    joints += limbs(names, "Hips", "Chest4")
+    return joints, ["LeftKnee", "RightKnee"]
+
+
+def biped():
+    names = sided("Bip01 {S} {W}", {
+        "clavicle": "Clavicle", "upper_arm": "UpperArm", "forearm": "Forearm", "hand": "Hand",
+        "thigh": "Thigh", "shin": "Calf", "foot": "Foot", "toe": "Toe0"})
+    joints = [("Bip01", None, "pelvis", "l"), ("Bip01 Pelvis", "Bip01", "pelvis", "l"),
+              ("Bip01 Spine", "Bip01 Pelvis", "spine", "l"),
+              ("Bip01 Spine1", "Bip01 Spine", "spine:1", "l"),
+              ("Bip01 Spine2", "Bip01 Spine1", "chest", "l"),
+              ("Bip01 Neck", "Bip01 Spine2", "neck", "l"),
+              ("Bip01 Head", "Bip01 Neck", "head", "l"), (None, "Bip01 Head", "head_end", "l")]
+    # Biped: thighs under Bip01 Spine, clavicles under Bip01 Neck, twist helpers as leaves.
+    joints += limbs(names, "Bip01 Spine", "Bip01 Neck")
+    for s in "LR":
+        joints.append((f"Bip01 {s} UpArmTwist", f"Bip01 {s} UpperArm", "forearm:twist",
+                       s.lower()))
+        joints.append((None, f"Bip01 {s} UpArmTwist", "forearm:twist", s.lower()))
+    return joints, ["Bip01 L Calf", "Bip01 R Calf"]
+
+
+def daz():
+    names = sided("{s}{W}", {
+        "clavicle": "Collar", "upper_arm": "Shldr", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "Thigh", "shin": "Shin", "foot": "Foot"})
+    joints = trunk(["hip", "abdomen", "chest", "neck", "head"])
+    joints += limbs(names, "hip", "chest")
+    # Poser's buttocks: a joint at the hip point with the thigh at zero offset below it.
+    out = []
+    for j in joints:
+        if j[0] in ("lThigh", "rThigh"):
+            s = j[0][0]
+            out.append((f"{s}Buttock", "hip", "thigh", s))
+            out.append((j[0], f"{s}Buttock", "thigh", s))
+        else:
+            out.append(j)
+    return out, ["lShin", "rShin"]
+
+
+def unreal():
+    names = sided("{W}_{s}", {
+        "clavicle": "clavicle", "upper_arm": "upperarm", "forearm": "lowerarm", "hand": "hand",
+        "thigh": "thigh", "shin": "calf", "foot": "foot", "toe": "ball"})
+    joints = [("root", None, "pelvis:floor", "l"), ("pelvis", "root", "pelvis", "l"),
+              ("spine_01", "pelvis", "spine", "l"), ("spine_02", "spine_01", "spine:2", "l"),
+              ("spine_03", "spine_02", "chest", "l"), ("neck_01", "spine_03", "neck", "l"),
+              ("head", "neck_01", "head", "l"), (None, "head", "head_end", "l")]
+    joints += limbs(names, "pelvis", "spine_03", end_hand=False)
+    for s in "lr":
+        for finger, tip in (("index", "hand_end:i"), ("middle", "hand_end:m")):
+            joints.append((f"{finger}_01_{s}", f"hand_{s}", "hand_end", s))
+            joints.append((None, f"{finger}_01_{s}", tip, s))
+        joints.append((f"upperarm_twist_01_{s}", f"upperarm_{s}", "forearm:twist", s))
+        joints.append((f"calf_twist_01_{s}", f"calf_{s}", "foot:twist", s))
+    joints += [("ik_foot_root", "root", "pelvis:floor", "l"),
+               ("ik_foot_l", "ik_foot_root", "foot", "l"), ("ik_foot_r", "ik_foot_root", "foot", "r"),
+               ("ik_hand_root", "root", "pelvis:floor", "l"),
+               ("ik_hand_gun", "ik_hand_root", "hand", "r"),
+               ("ik_hand_l", "ik_hand_gun", "hand", "l"), ("ik_hand_r", "ik_hand_gun", "hand", "r")]
+    return joints, ["calf_l", "calf_r"]
+
+
+def smpl():
+    names = sided("{S}_{W}", {
+        "clavicle": "Collar", "upper_arm": "Shoulder", "forearm": "Elbow", "hand": "Wrist",
+        "thigh": "Hip", "shin": "Knee", "foot": "Ankle", "toe": "Foot"})
+    joints = [("Pelvis", None, "pelvis", "l"), ("Spine1", "Pelvis", "spine", "l"),
+              ("Spine2", "Spine1", "spine:2", "l"), ("Spine3", "Spine2", "chest", "l"),
+              ("Neck", "Spine3", "neck", "l"), ("Head", "Neck", "head", "l"),
+              (None, "Head", "head_end", "l")]
+    joints += limbs(names, "Pelvis", "Spine3", end_hand=False)
+    for s in "LR":
+        joints.append((f"{s}_Hand", f"{s}_Wrist", "hand_end", s.lower()))
+        joints.append((None, f"{s}_Hand", "hand_end:tip", s.lower()))
+    return joints, ["L_Knee", "R_Knee"]
+
+
+def asf():
+    names = sided("{s}{W}", {
+        "clavicle": "clavicle", "upper_arm": "humerus", "forearm": "radius", "hand": "wrist",
+        "thigh": "femur", "shin": "tibia", "foot": "foot", "toe": "toes"})
+    joints = [("root", None, "pelvis", "l"), ("lowerback", "root", "spine", "l"),
+              ("upperback", "lowerback", "spine:2", "l"), ("thorax", "upperback", "chest", "l"),
+              ("lowerneck", "thorax", "neck", "l"), ("upperneck", "lowerneck", "neck:2", "l"),
+              ("head", "upperneck", "head", "l"), (None, "head", "head_end", "l")]
+    joints += limbs(names, "root", "thorax", end_hand=False)
+    out = []
+    for j in joints:
+        if j[0] in ("lfemur", "rfemur"):
+            # amc2bvh: lhipjoint sits on the root, lfemur at the hip.
+            s = j[0][0]
+            out.append((f"{s}hipjoint", "root", "pelvis", s))
+            out.append((j[0], f"{s}hipjoint", "thigh", s))
+        else:
+            out.append(j)
+    for s in "lr":
+        out += [(f"{s}hand", f"{s}wrist", "hand:hand", s),
+                (f"{s}fingers", f"{s}hand", "hand_end", s), (None, f"{s}fingers", "hand_end:tip", s),
+                (f"{s}thumb", f"{s}hand", "hand_end:thumb", s),
+                (None, f"{s}thumb", "hand_end:thumbtip", s)]
+    return out, ["ltibia", "rtibia"]
+
+
+def rokoko():
+    # Rokoko / Perception Neuron with fingers (LeftInHandIndex) and face joints.
+    names = sided("{Side}{W}", {
+        "clavicle": "Shoulder", "upper_arm": "Arm", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase"})
+    joints = [("Hips", None, "pelvis", "l"), ("Spine", "Hips", "spine", "l"),
+              ("Spine1", "Spine", "spine:1", "l"), ("Spine2", "Spine1", "spine:2", "l"),
+              ("Spine3", "Spine2", "chest", "l"), ("Neck", "Spine3", "neck", "l"),
+              ("Neck1", "Neck", "neck:1", "l"), ("Head", "Neck1", "head", "l"),
+              ("HeadEnd", "Head", "head_end", "l"), (None, "HeadEnd", "head_end", "l"),
+              ("LeftEye", "Head", "head:eye", "l"), (None, "LeftEye", "head:eyetip", "l"),
+              ("RightEye", "Head", "head:eye", "r"), (None, "RightEye", "head:eyetip", "r"),
+              ("Jaw", "Head", "head:jaw", "l"), (None, "Jaw", "head:chin", "l")]
+    joints += limbs(names, "Hips", "Spine3", end_hand=False)
+    for side, s in (("Left", "l"), ("Right", "r")):
+        for finger in ("Index", "Middle", "Ring"):
+            joints += [(f"{side}InHand{finger}", f"{side}Hand", "hand:in", s),
+                       (f"{side}Hand{finger}1", f"{side}InHand{finger}", "hand_end", s),
+                       (f"{side}Hand{finger}2", f"{side}Hand{finger}1", "hand_end:2", s),
+                       (None, f"{side}Hand{finger}2", "hand_end:tip", s)]
+        joints += [(f"{side}HandThumb1", f"{side}Hand", "hand_end:thumb", s),
+                   (None, f"{side}HandThumb1", "hand_end:thumbtip", s)]
+    return joints, ["LeftLeg", "RightLeg"]
+
+
+def unnamed():
+    # joint1 … joint20, children in no anatomical order (right before left, neck first).
+    plan = [("pelvis", None, "l"), ("thigh", "pelvis", "r"), ("shin", "thigh.r", "r"),
+            ("foot", "shin.r", "r"), ("toe", "foot.r", "r"), ("chest", "pelvis", "l"),
+            ("neck", "chest", "l"), ("head", "neck", "l"), ("clavicle", "chest", "r"),
+            ("upper_arm", "clavicle.r", "r"), ("forearm", "upper_arm.r", "r"),
+            ("hand", "forearm.r", "r"), ("clavicle", "chest", "l"),
+            ("upper_arm", "clavicle.l", "l"), ("forearm", "upper_arm.l", "l"),
+            ("hand", "forearm.l", "l"), ("thigh", "pelvis", "l"), ("shin", "thigh.l", "l"),
+            ("foot", "shin.l", "l"), ("toe", "foot.l", "l")]
+    trunk_parts = {"pelvis", "chest", "neck", "head"}
+    key = {}
+    joints = []
+    for i, (part, parent, s) in enumerate(plan):
+        name = f"joint{i + 1}"
+        key[part if part in trunk_parts else f"{part}.{s}"] = name
+        parent_name = None if parent is None else key[parent]
+        joints.append((name, parent_name, part, s))
+    ends = [(key["head"], "head_end", "l"), (key["hand.r"], "hand_end", "r"),
+            (key["hand.l"], "hand_end", "l"), (key["toe.r"], "toe_end", "r"),
+            (key["toe.l"], "toe_end", "l")]
+    joints += [(None, parent, k, s) for parent, k, s in ends]
+    return joints, [key["shin.l"], key["shin.r"]], key
+
+
+def mixamo(prefix="mixamorig_", fingers=False, prop=None):
+    names = sided(prefix + "{Side}{W}", {
+        "clavicle": "Shoulder", "upper_arm": "Arm", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase"})
+    joints = trunk([prefix + n for n in ("Hips", "Spine", "Spine2", "Neck", "Head")])
+    joints += limbs(names, prefix + "Hips", prefix + "Spine2", end_hand=not fingers)
+    if fingers:
+        for side, s in (("Left", "l"), ("Right", "r")):
+            for finger, tip in (("Index1", "hand_end:i"), ("Middle1", "hand_end:m")):
+                joints += [(f"{prefix}{side}Hand{finger}", f"{prefix}{side}Hand", "hand_end", s),
+                           (None, f"{prefix}{side}Hand{finger}", tip, s)]
+    if prop:
+        joints += [(prop, f"{prefix}RightHand", "hand:grip", "r"),
+                   (None, prop, "hand:poletip", "r")]
+    return joints, [prefix + "LeftLeg", prefix + "RightLeg"]
+
+
+def rigify_def():
+    # Blender Rigify deform bones: DEF- prefix, limbs split in two (thigh.L, thigh.L.001),
+    # pelvis side bones and breasts as extra chains.
+    joints = [("DEF-spine", None, "pelvis", "l")]
+    for s in "LR":
+        side = s.lower()
+        joints += [(f"DEF-pelvis.{s}", "DEF-spine", "pelvis", side),
+                   (None, f"DEF-pelvis.{s}", "pelvis:side", side)]
+        chain = [("thigh", "thigh"), ("thigh.001", "thigh:mid"), ("shin", "shin"),
+                 ("shin.001", "shin:mid"), ("foot", "foot"), ("toe", "toe")]
+        parent = "DEF-spine"
+        for bone, key in chain:
+            name = f"DEF-{bone.split('.')[0]}.{s}" + (".001" if "." in bone else "")
+            joints.append((name, parent, key, side))
+            parent = name
+        joints.append((None, parent, "toe_end", side))
+    spine = [("DEF-spine.001", "spine"), ("DEF-spine.002", "spine:2"),
+             ("DEF-spine.003", "chest"), ("DEF-spine.004", "neck"), ("DEF-spine.005", "neck:2"),
+             ("DEF-spine.006", "head")]
+    parent = "DEF-spine"
+    for name, key in spine:
+        joints.append((name, parent, key, "l"))
+        parent = name
+    joints.append((None, parent, "head_end", "l"))
+    for s in "LR":
+        side = s.lower()
+        chain = [("shoulder", "clavicle"), ("upper_arm", "upper_arm"),
+                 ("upper_arm.001", "upper_arm:mid"), ("forearm", "forearm"),
+                 ("forearm.001", "forearm:mid"), ("hand", "hand")]
+        parent = "DEF-spine.003"
+        for bone, key in chain:
+            name = f"DEF-{bone.split('.')[0]}.{s}" + (".001" if "." in bone else "")
+            joints.append((name, parent, key, side))
+            parent = name
+        joints.append((None, parent, "hand_end", side))
+        joints += [(f"DEF-breast.{s}", "DEF-spine.003", "chest:breast", side),
+                   (None, f"DEF-breast.{s}", "chest:nipple", side)]
+    return joints, ["DEF-shin.L", "DEF-shin.R"]
+
+
+def cmu_motionbuilder():
+    # CMU's MotionBuilder-friendly release: LHipJoint on the hips, LowerBack, Neck1,
+    # LeftFingerBase and LThumb under the hand.
+    names = sided("{Side}{W}", {
+        "clavicle": "Shoulder", "upper_arm": "Arm", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase"})
+    joints = [("Hips", None, "pelvis", "l"), ("LowerBack", "Hips", "pelvis", "l"),
+              ("Spine", "LowerBack", "spine", "l"), ("Spine1", "Spine", "chest", "l"),
+              ("Neck", "Spine1", "neck", "l"), ("Neck1", "Neck", "neck:1", "l"),
+              ("Head", "Neck1", "head", "l"), (None, "Head", "head_end", "l")]
+    out = []
+    for j in limbs(names, "Hips", "Spine1", end_hand=False):
+        if j[0] in ("LeftUpLeg", "RightUpLeg"):
+            joint = f"{j[0][0]}HipJoint"
+            out += [(joint, "Hips", "pelvis", j[3]), (j[0], joint, "thigh", j[3])]
+        else:
+            out.append(j)
+    for side, s in (("Left", "l"), ("Right", "r")):
+        out += [(f"{side}FingerBase", f"{side}Hand", "hand_end", s),
+                (f"{side}HandIndex1", f"{side}FingerBase", "hand_end:2", s),
+                (None, f"{side}HandIndex1", "hand_end:tip", s),
+                (f"{side[0]}Thumb", f"{side}Hand", "hand_end:thumb", s),
+                (None, f"{side[0]}Thumb", "hand_end:thumbtip", s)]
+    return joints + out, ["LeftLeg", "RightLeg"]
+
+
+def unrecognisable():
+    # A robot arm: one chain, nothing like a body.
+    joints = [("base", None, "pelvis", "l"), ("link1", "base", "spine", "l"),
+              ("link2", "link1", "chest", "l"), ("link3", "link2", "neck", "l"),
+              ("gripper", "link3", "head", "l"), (None, "gripper", "head_end", "l")]
+    return joints, []
+
+
+# Extra points (body coordinates) for helpers, fingers, props and face joints.
+EXTRA = {
+    "pelvis:floor": (0.0, 0.0, 0.0),
+    "spine:1": (0.0, 1.12, -0.01), "spine:2": (0.0, 1.18, -0.01), "spine:3": (0.0, 1.23, 0.0),
+    "neck:1": (0.0, 1.54, 0.01), "neck:2": (0.0, 1.54, 0.01),
+    "forearm:twist": (0.185, 1.28, -0.005), "foot:twist": (0.09, 0.28, 0.0),
+    "hand_end:i": (0.20, 0.81, 0.05), "hand_end:m": (0.19, 0.80, 0.03),
+    "hand_end:2": (0.19, 0.77, 0.03), "hand_end:tip": (0.19, 0.74, 0.03),
+    "hand_end:thumb": (0.17, 0.85, 0.06), "hand_end:thumbtip": (0.16, 0.81, 0.09),
+    "hand:hand": (0.19, 0.87, 0.02), "hand:in": (0.19, 0.86, 0.03),
+    "hand:grip": (0.19, 0.86, 0.04), "hand:poletip": (0.19, 0.86, 1.54),
+    "head:eye": (0.03, 1.66, 0.09), "head:eyetip": (0.03, 1.66, 0.10),
+    "head:jaw": (0.0, 1.60, 0.05), "head:chin": (0.0, 1.56, 0.10),
+    "pelvis:side": (0.12, 0.95, 0.0), "thigh:mid": (0.09, 0.70, 0.005),
+    "shin:mid": (0.09, 0.285, -0.01), "upper_arm:mid": (0.185, 1.285, -0.005),
+    "forearm:mid": (0.19, 1.015, 0.005), "chest:breast": (0.1, 1.30, 0.08),
+    "chest:nipple": (0.1, 1.30, 0.12),
+}
+for k, v in EXTRA.items():
+    BODY[k] = v
+
+
+def main():
+    write("xsens_mvn.bvh", *xsens(), arms="t")
+    write("biped_zup_inches.bvh", *biped(), axes=Z_UP_FACE_Y, unit=0.0254)
+    write("daz_poser_apose.bvh", *daz(), arms="a")
+    write("unreal_zup.bvh", *unreal(), axes=Z_UP_FACE_Y)
+    write("smpl_metres.bvh", *smpl(), unit=1.0, arms="t")
+    write("asf_millimetres.bvh", *asf(), unit=0.001)
+    write("rokoko_fingers_face.bvh", *rokoko())
+    joints, shins, _ = unnamed()
+    write("unnamed_joints.bvh", joints, shins, yaw=130.0)
+    write("mixamo_zero_pose_lying.bvh", *mixamo(), lying=True)
+    write("mixamo_prop_in_hand.bvh", *mixamo(prefix="", fingers=True, prop="Object01"))
+    write("rigify_def_segments.bvh", *rigify_def(), unit=1.0)
+    write("cmu_motionbuilder.bvh", *cmu_motionbuilder())
+    write("unrecognisable_chain.bvh", *unrecognisable())
+
+
+if __name__ == "__main__":
+    main()
