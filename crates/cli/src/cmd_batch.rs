@@ -22,7 +22,9 @@ pub struct BatchArgs {
     /// Output directory (created if missing); with --merge-summaries, the merged JSON file.
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
-    /// IK config (GMR JSON schema); default: the shipped LAFAN1 config for the robot.
+    /// IK config (GMR JSON schema), for every clip (bound to each skeleton when role-named);
+    /// default: per clip, GMR's tuned config or one derived from the roles (as without
+    /// --config in the main command).
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Output format of every clip.
@@ -122,10 +124,14 @@ fn print_table(summary: &Summary) {
     }
 }
 
-/// What every clip of a batch shares: the robot, its config and the options.
+/// What every clip of a batch shares: the robot, the config source and the options.
 struct Job {
     model: mjcf::Model,
-    config: IkConfig,
+    robot: String,
+    /// `--config`, read once.
+    given: Option<IkConfig>,
+    /// The shipped robot's tuned config.
+    tuned: Option<IkConfig>,
     options: RetargetOptions,
     format: Format,
 }
@@ -137,12 +143,15 @@ impl Job {
         human_height: Option<f64>,
         format: &str,
     ) -> anyhow::Result<Job> {
-        let config = crate::cmd_retarget::resolve_config(robot, config)?;
+        let given = config.map(IkConfig::from_file).transpose()?;
+        let tuned = crate::cmd_retarget::shipped_config(robot).transpose()?;
         let format = crate::cmd_retarget::parse_format(Some(format))?
             .context("an output format is required")?;
         Ok(Job {
             model: crate::shipped::robot_model(robot)?,
-            config,
+            robot: crate::cmd_retarget::robot_label(robot),
+            given,
+            tuned,
             options: RetargetOptions { human_height, ..RetargetOptions::default() },
             format,
         })
@@ -153,8 +162,19 @@ impl Job {
     fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<ClipResult> {
         remove_stale_temporaries(dst);
         let bvh = bvh::from_path(src)?;
-        let (motion, diag) = retarget::retarget_bvh(&bvh, &self.model, &self.config, &self.options)
-            .with_context(|| format!("{}: retargeting", src.display()))?;
+        let chosen = retarget::derive::choose(
+            &self.model,
+            &self.robot,
+            &bvh,
+            &self.options.fk,
+            self.given.clone(),
+            self.tuned.as_ref(),
+            false,
+        )
+        .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+        let (motion, diag) =
+            retarget::retarget_bvh(&bvh, &self.model, &chosen.config, &self.options)
+                .with_context(|| format!("{}: retargeting", src.display()))?;
         let quality = retarget::report::report(
             &motion,
             &self.model,
@@ -164,7 +184,7 @@ impl Job {
         Ok(ClipResult {
             frames: motion.num_frames(),
             metrics: serde_json::to_value(&quality)?,
-            inferred: Some(diag.human_inferred),
+            inferred: Some(crate::cmd_retarget::with_config(&diag.human_inferred, &chosen.summary)),
         })
     }
 }
