@@ -170,8 +170,10 @@ impl HumanBody {
         let mut sums: BTreeMap<Role, f64> = BTreeMap::new();
         let mut hip_midpoint = Vector3::zeros();
         for &f in &picked {
-            let points: BTreeMap<Role, Vector3<f64>> =
-                Role::ALL.iter().filter_map(|&r| Some((r, *motion.position(f, index(r)?)))).collect();
+            let points: BTreeMap<Role, Vector3<f64>> = Role::ALL
+                .iter()
+                .filter_map(|&r| Some((r, *motion.position(f, index(r)?))))
+                .collect();
             for (role, length) in paths(&points, 0.0) {
                 *sums.entry(role).or_default() += length;
             }
@@ -183,6 +185,13 @@ impl HumanBody {
             }
         }
         let count = picked.len() as f64;
+        let folds = trunk_folds(motion, humanoid, &picked, &index);
+        let mut kept = joints.clone();
+        if folds {
+            // A chest frame that is not along the trunk (a skeleton whose chest joint sits at
+            // the neck) would fold the robot's torso over: the chest is not tracked.
+            kept.remove(&Role::Chest);
+        }
         let mut paths: BTreeMap<Role, f64> =
             sums.into_iter().map(|(r, s)| (r, s / count)).collect();
         let ankle = ankle_height(motion, [index(Role::LeftFoot), index(Role::RightFoot)], ground);
@@ -190,7 +199,7 @@ impl HumanBody {
             *legs += ankle;
         }
         Ok(HumanBody {
-            joints,
+            joints: kept,
             frame_offsets: humanoid.frame_offsets.clone(),
             paths,
             hip_midpoint: hip_midpoint / count,
@@ -198,6 +207,33 @@ impl HumanBody {
             source: source.to_owned(),
         })
     }
+}
+
+/// Whether the chest's canonical frame points more than 60° away from the pelvis's (z axes)
+/// in most of the `picked` frames.
+fn trunk_folds(
+    motion: &HumanMotion,
+    humanoid: &Humanoid,
+    picked: &[usize],
+    index: &dyn Fn(Role) -> Option<usize>,
+) -> bool {
+    let (Some(p), Some(c), Some(po), Some(co)) = (
+        index(Role::Pelvis),
+        index(Role::Chest),
+        humanoid.frame_offsets.get(&Role::Pelvis),
+        humanoid.frame_offsets.get(&Role::Chest),
+    ) else {
+        return false;
+    };
+    let folded = picked
+        .iter()
+        .filter(|&&f| {
+            let zp = (motion.orientation(f, p) * po) * Vector3::z();
+            let zc = (motion.orientation(f, c) * co) * Vector3::z();
+            zp.angle(&zc) > 60f64.to_radians()
+        })
+        .count();
+    2 * folded > picked.len()
 }
 
 /// Joint positions of the canonical human (m, Z up, facing +x), as fractions of its height.
@@ -310,7 +346,9 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
     let ankle = [Side::Left, Side::Right]
         .iter()
         .zip(&roles.soles)
-        .filter_map(|(&side, sole)| Some(points.get(&Role::of(Part::Foot, side))?.z - sole.lowest.z))
+        .filter_map(|(&side, sole)| {
+            Some(points.get(&Role::of(Part::Foot, side))?.z - sole.lowest.z)
+        })
         .sum::<f64>()
         / 2.0;
     RobotSide { bodies, paths: paths(&points, ankle.max(0.0)) }
@@ -405,7 +443,10 @@ pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
         if role == Role::Pelvis {
             pos += rot.inverse() * human.hip_midpoint * scale;
         }
-        rows.push((e.clone(), Row { role, body: e.robot_body.clone(), joint: joint.clone(), rot, pos, scale }));
+        rows.push((
+            e.clone(),
+            Row { role, body: e.robot_body.clone(), joint: joint.clone(), rot, pos, scale },
+        ));
     }
     let height = human.height * config.human_height_assumption / canonical.height;
     let mut text = String::new();
@@ -424,7 +465,14 @@ pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
             .iter()
             .filter_map(|e| {
                 let (_, row) = rows.iter().find(|(o, _)| o.robot_body == e.robot_body)?;
-                Some((row.body.clone(), row.joint.clone(), e.pos_weight, e.rot_weight, row.pos, row.rot))
+                Some((
+                    row.body.clone(),
+                    row.joint.clone(),
+                    e.pos_weight,
+                    e.rot_weight,
+                    row.pos,
+                    row.rot,
+                ))
             })
             .collect();
         write_table(&mut text, k + 1, &entries, k == 1);
@@ -496,7 +544,12 @@ fn config_json(rows: &[Row], height: f64) -> String {
     text
 }
 
-fn write_header(text: &mut String, config: &IkConfig, joints: &BTreeMap<Role, String>, height: f64) {
+fn write_header(
+    text: &mut String,
+    config: &IkConfig,
+    joints: &BTreeMap<Role, String>,
+    height: f64,
+) {
     let root = Role::from_name(&config.human_root_name)
         .and_then(|r| joints.get(&r))
         .cloned()
@@ -656,8 +709,13 @@ pub fn choose(
 /// (GMR's configs pick other bodies for some roles, e.g. the N1's thigh roll link): offsets
 /// of different bodies are not comparable, so only shared (robot body, human joint) pairs
 /// count in [`largest_offset_difference`].
-fn bind_names(derived: &IkConfig, tuned: &IkConfig, _human: &HumanBody) -> IkConfig {
+/// Hands are left out: their canonical frame is the forearm's in the reference pose, so it
+/// carries whatever bend the subject's wrist had there.
+fn bind_names(derived: &IkConfig, tuned: &IkConfig, human: &HumanBody) -> IkConfig {
+    let hands: Vec<&String> =
+        [Role::LeftHand, Role::RightHand].iter().filter_map(|r| human.joints.get(r)).collect();
     let mut out = derived.clone();
+    out.ik_match_table1.retain(|e| !hands.contains(&&e.human_body));
     out.ik_match_table1.retain(|e| {
         tuned
             .ik_match_table1

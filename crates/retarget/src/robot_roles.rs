@@ -420,9 +420,9 @@ impl<'m> Recogniser<'m> {
         let hips = [legs[0].root(), legs[1].root()];
         let mut across = hips[0] - hips[1];
         across.z = 0.0;
-        let across = across.try_normalize(1e-9).ok_or_else(|| {
-            self.not_humanoid("the two legs start at the same point".to_owned())
-        })?;
+        let across = across
+            .try_normalize(1e-9)
+            .ok_or_else(|| self.not_humanoid("the two legs start at the same point".to_owned()))?;
         let (chest, hands) = self.arms(pelvis, &feet, across, (hips[0] + hips[1]) / 2.0)?;
         let arms = hands
             .iter()
@@ -442,12 +442,18 @@ impl<'m> Recogniser<'m> {
             None => match self.named_left_first(&legs, &arms) {
                 Some(first) => {
                     let left = if first { across } else { -across };
-                    (left.cross(&Vector3::z()), "from the sides' names (no knee range or foot shape)".to_owned())
+                    (
+                        left.cross(&Vector3::z()),
+                        "from the sides' names (no knee range or foot shape)".to_owned(),
+                    )
                 }
                 None => {
                     let ahead = across.cross(&Vector3::z());
                     let forward = if ahead.x < 0.0 { -ahead } else { ahead };
-                    (forward, "assumed towards +x (no knee range, foot shape or side names)".to_owned())
+                    (
+                        forward,
+                        "assumed towards +x (no knee range, foot shape or side names)".to_owned(),
+                    )
                 }
             },
         };
@@ -480,7 +486,8 @@ impl<'m> Recogniser<'m> {
             let point = self.data.xpos[head];
             roles.insert(Role::Head, self.role(head, point, rule, Part::Head));
         }
-        for (side, leg, arm) in [(Side::Left, &legs[0], &arms[0]), (Side::Right, &legs[1], &arms[1])]
+        for (side, leg, arm) in
+            [(Side::Left, &legs[0], &arms[0]), (Side::Right, &legs[1], &arms[1])]
         {
             self.limb_roles(&mut roles, side, leg, [Part::Thigh, Part::Shin, Part::Foot], "hip");
             self.limb_roles(
@@ -496,7 +503,8 @@ impl<'m> Recogniser<'m> {
                 return Err(self.not_humanoid(format!("the {side:?} leg has no foot")));
             }
         }
-        let soles = [self.sole(&roles, &legs[0], Side::Left), self.sole(&roles, &legs[1], Side::Right)];
+        let soles =
+            [self.sole(&roles, &legs[0], Side::Left), self.sole(&roles, &legs[1], Side::Right)];
         let arm_ends = [arms[0].end_point, arms[1].end_point];
         Ok(RobotRoles {
             base: self.base,
@@ -529,9 +537,11 @@ impl<'m> Recogniser<'m> {
                 .min_by(|&a, &b| self.lowest[a].total_cmp(&self.lowest[b]).then(b.cmp(&a)))
                 .unwrap_or(root)
         };
-        let Some(a) = self.children[self.base].iter().map(|&c| lowest_in(c)).min_by(|&a, &b| {
-            self.lowest[a].total_cmp(&self.lowest[b]).then(b.cmp(&a))
-        }) else {
+        let Some(a) = self.children[self.base]
+            .iter()
+            .map(|&c| lowest_in(c))
+            .min_by(|&a, &b| self.lowest[a].total_cmp(&self.lowest[b]).then(b.cmp(&a)))
+        else {
             return Err(self.not_humanoid("the floating base carries no bodies".to_owned()));
         };
         let za = self.lowest[a];
@@ -602,10 +612,8 @@ impl<'m> Recogniser<'m> {
         let end = *chain.last().unwrap_or(&0);
         let all = self.hinges(&chain);
         let Some(first) = all.first().copied() else {
-            return Err(self.not_humanoid(format!(
-                "the {what} ending in `{}` has no joint",
-                self.name(end)
-            )));
+            return Err(self
+                .not_humanoid(format!("the {what} ending in `{}` has no joint", self.name(end))));
         };
         let root = first.anchor;
         let end_point = self.end_point(&chain, root);
@@ -764,7 +772,9 @@ impl<'m> Recogniser<'m> {
         let from = self.lca(chest, top);
         let path = self.path(from, top);
         match path.iter().rev().find(|&&b| self.model.bodies[b].jnt_num > 0) {
-            Some(&b) => Some((b, "last jointed body on the way to the top of the robot".to_owned())),
+            Some(&b) => {
+                Some((b, "last jointed body on the way to the top of the robot".to_owned()))
+            }
             None => Some((top, "the highest body above the shoulders".to_owned())),
         }
     }
@@ -878,10 +888,7 @@ impl<'m> Recogniser<'m> {
             .map(|(_, p)| *p)
             .min_by(|a, b| a.z.total_cmp(&b.z))
             .or_else(|| {
-                bodies
-                    .iter()
-                    .map(|&b| self.data.xpos[b])
-                    .min_by(|a, b| a.z.total_cmp(&b.z))
+                bodies.iter().map(|&b| self.data.xpos[b]).min_by(|a, b| a.z.total_cmp(&b.z))
             })
             .unwrap_or_else(Vector3::zeros);
         Sole { body, geoms: geoms.into_iter().map(|(g, _)| g).collect(), lowest }

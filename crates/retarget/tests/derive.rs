@@ -42,9 +42,19 @@ fn print_g1() {
         }
         println!();
         for e in &config.ik_match_table1 {
-            let t = tuned.ik_match_table1.iter().find(|t| t.human_body == e.human_body || t.human_body == format!("{}Mod", e.human_body));
-            let diff = t.map(|t| (t.robot_body.clone(), e.rot_offset.angle_to(&t.rot_offset).to_degrees()));
-            println!("{:<28} {:<14} pos {:.3?} rot {:.3?} vs {:?}", e.robot_body, e.human_body, e.pos_offset.as_slice(), e.rot_offset.coords.as_slice(), diff);
+            let t = tuned.ik_match_table1.iter().find(|t| {
+                t.human_body == e.human_body || t.human_body == format!("{}Mod", e.human_body)
+            });
+            let diff = t
+                .map(|t| (t.robot_body.clone(), e.rot_offset.angle_to(&t.rot_offset).to_degrees()));
+            println!(
+                "{:<28} {:<14} pos {:.3?} rot {:.3?} vs {:?}",
+                e.robot_body,
+                e.human_body,
+                e.pos_offset.as_slice(),
+                e.rot_offset.coords.as_slice(),
+                diff
+            );
         }
     }
 }
