@@ -354,6 +354,9 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
     RobotSide { bodies, paths: paths(&points, ankle.max(0.0)) }
 }
 
+/// A written table row: robot body, human joint, position and rotation weights, offsets.
+type TableRow = (String, String, f64, f64, Vector3<f64>, UnitQuaternion<f64>);
+
 /// One derived row before it is written: role, robot body, human joint, offsets, scale.
 struct Row {
     role: Role,
@@ -461,7 +464,7 @@ pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
         .collect::<Result<_, Error>>()?;
     write_scales(&mut text, &scales);
     for (k, table) in [&config.ik_match_table1, &config.ik_match_table2].into_iter().enumerate() {
-        let entries: Vec<(String, String, f64, f64, Vector3<f64>, UnitQuaternion<f64>)> = table
+        let entries: Vec<TableRow> = table
             .iter()
             .filter_map(|e| {
                 let (_, row) = rows.iter().find(|(o, _)| o.robot_body == e.robot_body)?;
@@ -532,7 +535,7 @@ fn config_json(rows: &[Row], height: f64) -> String {
         .collect();
     write_scales(&mut text, &scales);
     for (k, table) in [0, 2].iter().enumerate() {
-        let entries: Vec<(String, String, f64, f64, Vector3<f64>, UnitQuaternion<f64>)> = rows
+        let entries: Vec<TableRow> = rows
             .iter()
             .map(|r| {
                 let w = WEIGHTS.iter().find(|(p, _)| *p == r.role.part()).map_or([0.0; 4], |w| w.1);
@@ -575,12 +578,7 @@ fn write_scales(text: &mut String, scales: &[(String, f64)]) {
     text.push_str("  },\n");
 }
 
-fn write_table(
-    text: &mut String,
-    number_: usize,
-    entries: &[(String, String, f64, f64, Vector3<f64>, UnitQuaternion<f64>)],
-    last: bool,
-) {
+fn write_table(text: &mut String, number_: usize, entries: &[TableRow], last: bool) {
     let _ = writeln!(text, "  \"ik_match_table{number_}\": {{");
     for (i, (body, joint, wp, wr, p, q)) in entries.iter().enumerate() {
         let comma = if i + 1 < entries.len() { "," } else { "" };
