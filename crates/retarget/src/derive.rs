@@ -755,7 +755,7 @@ mod tests {
         assert_eq!(number(0.5), "0.5");
         assert_eq!(number(-1e-12), "0.0");
         assert_eq!(number(100.0), "100.0");
-        assert_eq!(number(0.707106781186), "0.707106781");
+        assert_eq!(number(0.123456789123), "0.123456789");
         assert_eq!(escape("a\"b"), "a\\\"b");
     }
 }

@@ -98,7 +98,7 @@ fn measure(
         let frame = |(b, off): (usize, UnitQuaternion<f64>)| data.xquat[b] * off;
         let p = frame(pelvis);
         let up_ok = |q: UnitQuaternion<f64>| (q * Vector3::z()).z > 40f64.to_radians().cos();
-        if up_ok(p) && chest.map_or(true, |c| up_ok(frame(c))) {
+        if up_ok(p) && chest.is_none_or(|c| up_ok(frame(c))) {
             upright += 1;
         }
         let h = human.orientation(t, h_pelvis) * h_offset;
