@@ -406,7 +406,7 @@ pub fn derive(
     IkConfig::from_json_str(&text, source)
 }
 
-/// A role-named config ([`derive`] against [`HumanBody::canonical`]) bound to `human` (see
+/// A role-named config ([`derive()`] against [`HumanBody::canonical`]) bound to `human` (see
 /// the module docs). Entries whose human name is not a role, or whose role the skeleton
 /// lacks, are errors naming them.
 pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
@@ -626,7 +626,7 @@ pub enum Choice {
     Bound,
     /// The robot's tuned config (GMR's, for LAFAN1-named skeletons).
     Tuned,
-    /// Derived from the robot's and the skeleton's roles ([`derive`]).
+    /// Derived from the robot's and the skeleton's roles ([`derive()`]).
     Derived,
 }
 
