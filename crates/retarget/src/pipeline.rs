@@ -373,6 +373,11 @@ impl<'a> Prepared<'a> {
         let mut solver = self.solver()?;
         let nq = self.model.nq;
         let first = range.start.saturating_sub(lead_in);
+        if matches!(self.options.mode, SolveMode::Plausible(_)) {
+            if let Some(start) = self.start_pose(first) {
+                solver.set_qpos(&start)?;
+            }
+        }
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((range.end - first) * nq);
         let mut frames = Vec::with_capacity(range.end - first);
@@ -404,6 +409,45 @@ impl<'a> Prepared<'a> {
         }
         let skip = range.start - first;
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
+    }
+
+    /// `qpos0` with the free root moved to frame `f`'s target of the root body and turned to
+    /// its heading (about world z), so that a solve starting far from the origin, or facing
+    /// away from the robot's rest heading, starts where the motion is. `None` without a free
+    /// root or a task on its body.
+    fn start_pose(&self, f: usize) -> Option<Vec<f64>> {
+        let model = self.model;
+        let root = model.joints.iter().find(|j| j.kind == JointType::Free)?;
+        let &(_, slot) = self.tracked.iter().find(|(b, _)| *b == root.body)?;
+        let target = self.targets.get(f * self.slots + slot)?;
+        let mut q = model.qpos0.clone();
+        let a = root.qpos_adr;
+        let rest = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            q[a + 3],
+            q[a + 4],
+            q[a + 5],
+            q[a + 6],
+        ));
+        let goal = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            target.quat[0],
+            target.quat[1],
+            target.quat[2],
+            target.quat[3],
+        ));
+        // The heading change that turns the rest forward axis onto the target's.
+        let heading = |r: &nalgebra::UnitQuaternion<f64>| {
+            let f = r * (rest.inverse() * Vector3::x());
+            f.y.atan2(f.x)
+        };
+        let turn = nalgebra::UnitQuaternion::from_axis_angle(
+            &Vector3::z_axis(),
+            heading(&goal) - heading(&rest),
+        );
+        let start = turn * rest;
+        q[a] = target.pos.x;
+        q[a + 1] = target.pos.y;
+        q[a + 3..a + 7].copy_from_slice(&[start.w, start.i, start.j, start.k]);
+        Some(q)
     }
 
     fn frame_targets(&self, f: usize) -> &[Pose] {
