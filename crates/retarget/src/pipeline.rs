@@ -373,15 +373,22 @@ impl<'a> Prepared<'a> {
         let mut solver = self.solver()?;
         let nq = self.model.nq;
         let first = range.start.saturating_sub(lead_in);
+        // The smoothing filter looks one frame ahead per pass: solve that far past the range
+        // (when the clip goes on) so the range's last frames are filtered as in one pass.
+        let passes = match &self.options.mode {
+            SolveMode::Plausible(p) => p.smoothing_passes,
+            SolveMode::Gmr => 0,
+        };
+        let end = (range.end + passes).min(self.num_frames());
         if matches!(self.options.mode, SolveMode::Plausible(_)) {
             if let Some(start) = self.start_pose(first) {
                 solver.set_qpos(&start)?;
             }
         }
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
-        let mut qpos = Vec::with_capacity((range.end - first) * nq);
-        let mut frames = Vec::with_capacity(range.end - first);
-        for f in first..range.end {
+        let mut qpos = Vec::with_capacity((end - first) * nq);
+        let mut frames = Vec::with_capacity(end - first);
+        for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt));
             if solver.qpos().iter().any(|v| !v.is_finite()) {
@@ -396,7 +403,7 @@ impl<'a> Prepared<'a> {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
                 solver.set_qpos(&smooth[..nq])?;
-                for (k, f) in (first..range.end).enumerate() {
+                for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     let targets = self.frame_targets(f);
@@ -408,6 +415,8 @@ impl<'a> Prepared<'a> {
             }
         }
         let skip = range.start - first;
+        qpos.truncate((range.end - first) * nq);
+        frames.truncate(range.end - first);
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
     }
 
