@@ -61,12 +61,15 @@ pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
     (Part::Pelvis, [0.0, 10.0, 100.0, 5.0]),
     (Part::Thigh, [0.0, 10.0, 10.0, 5.0]),
     (Part::Shin, [0.0, 10.0, 10.0, 5.0]),
-    (Part::Foot, [50.0, 10.0, 50.0, 10.0]),
+    (Part::Foot, [100.0, 10.0, 100.0, 10.0]),
     (Part::Chest, [0.0, 100.0, 0.0, 10.0]),
     (Part::UpperArm, [0.0, 100.0, 5.0, 100.0]),
     (Part::Forearm, [0.0, 10.0, 10.0, 5.0]),
     (Part::Hand, [0.0, 10.0, 10.0, 5.0]),
 ];
+
+/// A foot counts as flat on the floor while its ankle is within this of its flat height (m).
+const FLAT_FOOT: f64 = 0.03;
 
 /// Height of the canonical human (m).
 pub const CANONICAL_HEIGHT: f64 = 1.75;
@@ -107,6 +110,14 @@ const SCALE_ORDER: [Role; 14] = [
     Role::RightHand,
 ];
 
+/// One posture of a human: its role joints' positions (m, Z up) and canonical frames
+/// (`q_joint ⊗ offset`, [`fk::Humanoid::frame_offsets`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Posture {
+    pub points: BTreeMap<Role, Vector3<f64>>,
+    pub frames: BTreeMap<Role, UnitQuaternion<f64>>,
+}
+
 /// The human half of a derived config: one skeleton's joint per role, its frame offsets and
 /// its proportions (metres).
 #[derive(Debug, Clone, PartialEq)]
@@ -119,8 +130,14 @@ pub struct HumanBody {
     /// through the role joints ([`module docs`](self)); the pelvis's entry is the standing hip
     /// height (thigh + shin + ankle height).
     pub paths: BTreeMap<Role, f64>,
-    /// The hip midpoint in the pelvis joint's frame (m).
-    pub hip_midpoint: Vector3<f64>,
+    /// Sampled postures (up to 64 frames of the motion; the canonical human has one): what
+    /// the position offsets are fitted to ([`module docs`](self)).
+    pub postures: Vec<Posture>,
+    /// Height of the floor in the motion (m, the fk ground estimate; 0 for the canonical
+    /// human): the derived targets are shifted so that it lands on the robot's floor.
+    pub ground: f64,
+    /// Height of the ankle joints above the floor when the foot is flat (m).
+    pub ankle: f64,
     /// Subject height (m).
     pub height: f64,
     /// What this human is, for messages.
@@ -141,7 +158,9 @@ impl HumanBody {
             joints,
             frame_offsets,
             paths: paths(&points, ankle),
-            hip_midpoint: Vector3::zeros(),
+            postures: vec![Posture { frames: fk::canonical_frames(&points), points: points.clone() }],
+            ground: 0.0,
+            ankle,
             height: CANONICAL_HEIGHT,
             source: "the canonical human".to_owned(),
         }
@@ -167,8 +186,17 @@ impl HumanBody {
         let count = n.min(64);
         let picked: Vec<usize> =
             (0..count).map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 }).collect();
+        let ankle = ankle_height(motion, [index(Role::LeftFoot), index(Role::RightFoot)], ground);
+        let mut frame_offsets = humanoid.frame_offsets.clone();
+        twist_limbs(motion, &index, &mut frame_offsets);
+        for side in [Side::Left, Side::Right] {
+            let foot = Role::of(Part::Foot, side);
+            if let (Some(b), Some(offset)) = (index(foot), frame_offsets.get_mut(&foot)) {
+                *offset *= flat_foot(motion, b, *offset, ground + ankle + FLAT_FOOT);
+            }
+        }
         let mut sums: BTreeMap<Role, f64> = BTreeMap::new();
-        let mut hip_midpoint = Vector3::zeros();
+        let mut postures = Vec::with_capacity(picked.len());
         for &f in &picked {
             let points: BTreeMap<Role, Vector3<f64>> = Role::ALL
                 .iter()
@@ -177,12 +205,11 @@ impl HumanBody {
             for (role, length) in paths(&points, 0.0) {
                 *sums.entry(role).or_default() += length;
             }
-            if let (Some(p), Some(l), Some(r)) =
-                (index(Role::Pelvis), index(Role::LeftThigh), index(Role::RightThigh))
-            {
-                let mid = (motion.position(f, l) + motion.position(f, r)) / 2.0;
-                hip_midpoint += motion.orientation(f, p).inverse() * (mid - motion.position(f, p));
-            }
+            let frames = frame_offsets
+                .iter()
+                .filter_map(|(r, offset)| Some((*r, motion.orientation(f, index(*r)?) * offset)))
+                .collect();
+            postures.push(Posture { points, frames });
         }
         let count = picked.len() as f64;
         let folds = trunk_folds(motion, humanoid, &picked, &index);
@@ -194,19 +221,102 @@ impl HumanBody {
         }
         let mut paths: BTreeMap<Role, f64> =
             sums.into_iter().map(|(r, s)| (r, s / count)).collect();
-        let ankle = ankle_height(motion, [index(Role::LeftFoot), index(Role::RightFoot)], ground);
         if let Some(legs) = paths.get_mut(&Role::Pelvis) {
             *legs += ankle;
         }
         Ok(HumanBody {
             joints: kept,
-            frame_offsets: humanoid.frame_offsets.clone(),
+            frame_offsets,
             paths,
-            hip_midpoint: hip_midpoint / count,
+            postures,
+            ground,
+            ankle,
             height,
             source: source.to_owned(),
         })
     }
+}
+
+/// The limbs' canonical frames turned about their bones so that the knees flex about +y and
+/// the elbows about −y, as [`limb_frames`] turns the robot's: the flexion axis is the normal
+/// of the two bones (`proximal × distal`) averaged, in each bone's frame, over the frames
+/// where the joint bends more than 20°. The reference pose's forward direction fixes the
+/// twist of a bone only roughly (a forearm raised forward and turned in has its x wherever
+/// the palm was); the axis the joint really bends about makes the robot's knee and elbow
+/// bend where the human's do. Limbs that never bend keep their frames.
+fn twist_limbs(
+    motion: &HumanMotion,
+    index: &dyn Fn(Role) -> Option<usize>,
+    offsets: &mut BTreeMap<Role, UnitQuaternion<f64>>,
+) {
+    for side in [Side::Left, Side::Right] {
+        let limbs: [([Part; 3], &[Part], f64); 2] = [
+            ([Part::Thigh, Part::Shin, Part::Foot], &[Part::Thigh, Part::Shin], 1.0),
+            ([Part::UpperArm, Part::Forearm, Part::Hand], &[Part::UpperArm, Part::Forearm], -1.0),
+        ];
+        for (limb, bones, y_sign) in limbs {
+            let tw = std::env::var("TWIST").unwrap_or("both".into());
+            if tw == "none" || (tw == "arms" && limb[0] == Part::Thigh) || (tw == "legs" && limb[0] == Part::UpperArm) { continue; }
+            let roles = limb.map(|p| Role::of(p, side));
+            let Some(b) = roles.iter().map(|&r| index(r)).collect::<Option<Vec<_>>>() else {
+                continue;
+            };
+            let mut sums = [Vector3::zeros(); 2];
+            for f in 0..motion.num_frames {
+                let p = |i: usize| *motion.position(f, b[i]);
+                let (u, d) = (p(1) - p(0), p(2) - p(1));
+                if u.angle(&d) < 20f64.to_radians() {
+                    continue;
+                }
+                let Some(n) = u.cross(&d).try_normalize(1e-12) else { continue };
+                for (k, &part) in bones.iter().enumerate() {
+                    let role = Role::of(part, side);
+                    if let Some(o) = offsets.get(&role) {
+                        sums[k] += (motion.orientation(f, b[k]) * o).inverse() * n * y_sign;
+                    }
+                }
+            }
+            for (k, &part) in bones.iter().enumerate() {
+                // The turn about z that lays the axis (seen in the bone's frame) along +y.
+                let v = sums[k];
+                if v.x.hypot(v.y) < 1e-9 {
+                    continue;
+                }
+                let turn = UnitQuaternion::from_axis_angle(
+                    &Vector3::z_axis(),
+                    v.y.atan2(v.x) - std::f64::consts::FRAC_PI_2,
+                );
+                let mut roles = vec![Role::of(part, side)];
+                if part == Part::Forearm {
+                    // The hand's frame continues the forearm's.
+                    roles.push(Role::of(Part::Hand, side));
+                }
+                for role in roles {
+                    if let Some(o) = offsets.get_mut(&role) {
+                        *o *= turn;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The turn that makes a foot's canonical frame (`q_joint ⊗ offset`, taken in the reference
+/// pose) flat on average over the frames where its joint is below `below` (the foot flat
+/// on the floor): a reference pose on tiptoe (the tallest frame of a jump take) would
+/// otherwise tell the robot to stand on its toes. Identity when no frame is that low.
+fn flat_foot(
+    motion: &HumanMotion,
+    body: usize,
+    offset: UnitQuaternion<f64>,
+    below: f64,
+) -> UnitQuaternion<f64> {
+    let up: Vector3<f64> = (0..motion.num_frames)
+        .filter(|&f| motion.position(f, body).z < below)
+        .map(|f| (motion.orientation(f, body) * offset).inverse() * Vector3::z())
+        .filter(|v| v.iter().all(|x| x.is_finite()))
+        .sum();
+    UnitQuaternion::rotation_between(&Vector3::z(), &up).unwrap_or_default()
 }
 
 /// Whether the chest's canonical frame points more than 60° away from the pelvis's (z axes)
@@ -323,17 +433,178 @@ fn ankle_height(motion: &HumanMotion, feet: [Option<usize>; 2], ground: f64) -> 
     z[(z.len() - 1) / 20].clamp(0.02, 0.15)
 }
 
+/// The chains of the canonical pose: each role with the roles its segment may start from, in
+/// order of preference (none: from the hip midpoint, seen from the pelvis's frame).
+const POSE_CHAINS: [(Role, &[Role]); 17] = [
+    (Role::Pelvis, &[]),
+    (Role::LeftThigh, &[]),
+    (Role::RightThigh, &[]),
+    (Role::LeftShin, &[Role::LeftThigh]),
+    (Role::RightShin, &[Role::RightThigh]),
+    (Role::LeftFoot, &[Role::LeftShin]),
+    (Role::RightFoot, &[Role::RightShin]),
+    (Role::Spine, &[Role::Pelvis]),
+    (Role::Chest, &[Role::Spine, Role::Pelvis]),
+    (Role::LeftUpperArm, &[Role::Chest, Role::Spine, Role::Pelvis]),
+    (Role::RightUpperArm, &[Role::Chest, Role::Spine, Role::Pelvis]),
+    (Role::LeftForearm, &[Role::LeftUpperArm]),
+    (Role::RightForearm, &[Role::RightUpperArm]),
+    (Role::LeftHand, &[Role::LeftForearm]),
+    (Role::RightHand, &[Role::RightForearm]),
+    (Role::Neck, &[Role::Chest, Role::Spine, Role::Pelvis]),
+    (Role::Head, &[Role::Neck, Role::Chest, Role::Spine, Role::Pelvis]),
+];
+
+/// One posture's segments of the canonical pose: per role the role it starts from (`None`:
+/// the hip midpoint) and the segment seen from that role's canonical frame (the pelvis's for
+/// the hip midpoint). `points` are joint positions, `frames` their canonical frames.
+fn segments(
+    points: &BTreeMap<Role, Vector3<f64>>,
+    frames: &BTreeMap<Role, UnitQuaternion<f64>>,
+) -> BTreeMap<Role, (Option<Role>, Vector3<f64>)> {
+    let mut out = BTreeMap::new();
+    let (Some(l), Some(r), Some(pelvis)) = (
+        points.get(&Role::LeftThigh),
+        points.get(&Role::RightThigh),
+        frames.get(&Role::Pelvis),
+    ) else {
+        return out;
+    };
+    let mid = (l + r) / 2.0;
+    for (role, parents) in POSE_CHAINS {
+        let Some(p) = points.get(&role) else { continue };
+        let from = parents.iter().find(|a| points.contains_key(a) && frames.contains_key(a));
+        let segment = match from {
+            Some(a) => (Some(*a), frames[a].inverse() * (p - points[a])),
+            None if parents.is_empty() => (None, pelvis.inverse() * (p - mid)),
+            None => continue,
+        };
+        out.insert(role, segment);
+    }
+    out
+}
+
+/// A knee or elbow hinge of the robot, as the position fit sees it: its axis in the canonical
+/// frame of the limb's proximal role, the joint value that lays the limb straight, its range.
+#[derive(Debug, Clone, Copy)]
+struct MiddleHinge {
+    axis: nalgebra::Unit<Vector3<f64>>,
+    straight: f64,
+    range: [f64; 2],
+}
+
+/// The knee or elbow hinge of the limb `[proximal, mid, distal]` (the `mid` role body's hinge
+/// most across the bone), when it has a range: its world axis at `qpos0`, the joint value
+/// that lays the limb straight, its range.
+fn middle_hinge(
+    model: &Model,
+    data: &Data,
+    roles: &RobotRoles,
+    [proximal, mid, distal]: [Role; 3],
+) -> Option<(Vector3<f64>, f64, [f64; 2])> {
+    let point = |r: Role| roles.roles.get(&r).map(|x| x.point);
+    let (u, f) = ((point(mid)? - point(proximal)?), (point(distal)? - point(mid)?));
+    let body = roles.body(mid)?;
+    let (j, joint) = model
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|(_, j)| j.body == body && j.kind == mjcf::JointType::Hinge)
+        .min_by(|a, b| {
+            let along = |j: usize| data.xaxis[j].dot(&f).abs();
+            along(a.0).total_cmp(&along(b.0))
+        })?;
+    let a = data.xaxis[j];
+    let (u, f) = (u - a * a.dot(&u), f - a * a.dot(&f));
+    // Turning the distal bone by θ about the axis lays it along the proximal one.
+    let theta = a.dot(&f.cross(&u)).atan2(f.dot(&u));
+    Some((a, model.qpos0[joint.qpos_adr] + theta, joint.range?))
+}
+
+/// The robot's canonical frames ([`RobotRoles::canonical_frames`]) with each limb's twist
+/// taken from its knee or elbow instead of from the facing: the upper arm, forearm and
+/// hand turned about their bone so that the elbow flexes about −y (forward, as a human
+/// elbow with the arm hanging), the thigh and shin so that the knee flexes about +y
+/// (backward). A robot elbow that bends sideways at `qpos0` (ToddlerBot's) is then matched
+/// with the human's flexion, not its abduction. The flexion sense is the larger side of the
+/// range from straight. Also the knee and elbow hinges in the new frames.
+fn limb_frames(
+    model: &Model,
+    data: &Data,
+    roles: &RobotRoles,
+) -> (BTreeMap<Role, UnitQuaternion<f64>>, BTreeMap<Role, MiddleHinge>) {
+    let mut frames = roles.canonical_frames();
+    let mut hinges = BTreeMap::new();
+    for side in [Side::Left, Side::Right] {
+        let limbs: [([Part; 3], &[Part], f64); 2] = [
+            ([Part::Thigh, Part::Shin, Part::Foot], &[Part::Thigh, Part::Shin], 1.0),
+            ([Part::UpperArm, Part::Forearm, Part::Hand], &[Part::UpperArm, Part::Forearm, Part::Hand], -1.0),
+        ];
+        for (limb, twisted, y_sign) in limbs {
+            let limb = limb.map(|p| Role::of(p, side));
+            let Some((axis, straight, [lo, hi])) = middle_hinge(model, data, roles, limb) else {
+                continue;
+            };
+            let flexion = if hi - straight >= straight - lo { axis } else { -axis };
+            for &part in twisted {
+                let role = Role::of(part, side);
+                let Some(c) = frames.get(&role) else { continue };
+                let z = c * Vector3::z();
+                let y = flexion * y_sign;
+                let Some(y) = (y - z * z.dot(&y)).try_normalize(0.5) else { continue };
+                let m = nalgebra::Matrix3::from_columns(&[y.cross(&z), y, z]);
+                let r = nalgebra::Rotation3::from_matrix_unchecked(m);
+                frames.insert(role, UnitQuaternion::from_rotation_matrix(&r));
+            }
+            if let Some(p) = frames.get(&limb[0]) {
+                let axis = nalgebra::Unit::new_normalize(p.inverse() * axis);
+                hinges.insert(limb[1], MiddleHinge { axis, straight, range: [lo, hi] });
+            }
+        }
+    }
+    (frames, hinges)
+}
+
+impl MiddleHinge {
+    /// The distal segment's frame relative to the proximal one, `rel` as the human has it,
+    /// turned back into the hinge's range: the hinge angle is the twist of `rel` about the
+    /// axis, clamped (the nearest end, angles modulo 2π).
+    fn clamp(&self, rel: UnitQuaternion<f64>) -> UnitQuaternion<f64> {
+        let v = Vector3::new(rel.i, rel.j, rel.k);
+        let phi = 2.0 * self.axis.dot(&v).atan2(rel.w);
+        let q = self.straight + phi;
+        let tau = std::f64::consts::TAU;
+        let [lo, hi] = self.range;
+        let Some((delta, _)) = [q - tau, q, q + tau]
+            .into_iter()
+            .map(|x| (x.clamp(lo, hi) - x, x))
+            .min_by(|x, y| x.0.abs().total_cmp(&y.0.abs()))
+        else {
+            return rel;
+        };
+        UnitQuaternion::from_axis_angle(&self.axis, delta) * rel
+    }
+}
+
 /// The robot's half: per role, body, `C_r⁻¹ ⊗ q_body`, body offset from the role point (in the
 /// body frame), and path lengths like [`HumanBody::paths`].
 struct RobotSide {
     bodies: BTreeMap<Role, (String, UnitQuaternion<f64>, Vector3<f64>)>,
     paths: BTreeMap<Role, f64>,
+    /// Per role: the segment to its role point from its parent role's ([`segments`]).
+    segments: BTreeMap<Role, (Option<Role>, Vector3<f64>)>,
+    /// Per role: the body origin from the role point, in the role's canonical frame.
+    origins: BTreeMap<Role, Vector3<f64>>,
+    /// Knee and elbow hinges, by the shin / forearm role.
+    hinges: BTreeMap<Role, MiddleHinge>,
+    /// The canonical frames used ([`limb_frames`]).
+    frames: BTreeMap<Role, UnitQuaternion<f64>>,
 }
 
 fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
     let mut data = Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
-    let frames = roles.canonical_frames();
+    let (frames, hinges) = limb_frames(model, &data, roles);
     let mut bodies = BTreeMap::new();
     for (role, r) in &roles.roles {
         let Some(c) = frames.get(role) else { continue };
@@ -351,7 +622,101 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
         })
         .sum::<f64>()
         / 2.0;
-    RobotSide { bodies, paths: paths(&points, ankle.max(0.0)) }
+    let origins = roles
+        .roles
+        .iter()
+        .filter_map(|(role, r)| {
+            Some((*role, frames.get(role)?.inverse() * (data.xpos[r.body] - r.point)))
+        })
+        .collect();
+    RobotSide {
+        bodies,
+        paths: paths(&points, ankle.max(0.0)),
+        segments: segments(&points, &frames),
+        origins,
+        hinges,
+        frames,
+    }
+}
+
+/// The position offset (in the target frame) that best puts `role`'s target where the robot
+/// body is when the robot copies the human's body frames (see the module docs): averaged
+/// over the human's postures, `M⁻¹ C_h⁻¹ (x_robot − p_target)`, where the robot's role points
+/// hang from its pelvis point (put at the scaled hip midpoint) along its own segments turned
+/// by the human's canonical frames (knees and elbows held in their ranges), the body origin
+/// `origin` from its role point, and `p_target` is GMR's scaling of the human joint (root
+/// by `root_scale` about the origin, the joint by `scale` about the root) with the human's
+/// floor moved to the robot's. `relative` is `M`, the target frame's rotation from the
+/// human's canonical frame. `None` when no posture has the frames needed.
+#[allow(clippy::too_many_arguments)]
+fn fitted_offset(
+    robot: &RobotSide,
+    human: &HumanBody,
+    role: Role,
+    origin: Vector3<f64>,
+    relative: UnitQuaternion<f64>,
+    root_scale: f64,
+    scale: f64,
+) -> Option<Vector3<f64>> {
+    // A foot's offset is fitted where it matters most and the copy is straightest: the
+    // postures with that foot flat on the floor (its ankle within 3 cm of its flat height),
+    // when there are any.
+    let planted = |p: &Posture| {
+        p.points.get(&role).is_some_and(|a| a.z - human.ground < human.ankle + FLAT_FOOT)
+    };
+    let foot = role.part() == Part::Foot && human.postures.iter().any(planted);
+    let mut sum = Vector3::zeros();
+    let mut count = 0usize;
+    for posture in human.postures.iter().filter(|p| !foot || planted(p)) {
+        if let Some(v) = copy_error(robot, posture, role, origin, root_scale, scale, human.ground) {
+            sum += v;
+            count += 1;
+        }
+    }
+    (count > 0).then(|| relative.inverse() * (sum / count as f64))
+}
+
+/// One posture's `C_h⁻¹ (x_robot − p_target)` for [`fitted_offset`].
+fn copy_error(
+    robot: &RobotSide,
+    posture: &Posture,
+    role: Role,
+    origin: Vector3<f64>,
+    root_scale: f64,
+    scale: f64,
+    ground: f64,
+) -> Option<Vector3<f64>> {
+    let (points, human) = (&posture.points, &posture.frames);
+    let mid = (points.get(&Role::LeftThigh)? + points.get(&Role::RightThigh)?) / 2.0;
+    let pelvis = points.get(&Role::Pelvis)?;
+    let target = (pelvis - mid) * root_scale
+        + (points.get(&role)? - pelvis) * scale
+        + Vector3::z() * (root_scale * ground);
+    // The robot's frames: the human's, knees and elbows turned back into their ranges.
+    let mut frames: BTreeMap<Role, UnitQuaternion<f64>> = BTreeMap::new();
+    let mut at: BTreeMap<Role, Vector3<f64>> = BTreeMap::new();
+    for (r, _) in POSE_CHAINS {
+        let Some((from, v)) = robot.segments.get(&r) else { continue };
+        let Some(c) = human.get(&r) else { continue };
+        let (start, turn) = match from {
+            Some(a) => (*at.get(a)?, *frames.get(a)?),
+            None => (Vector3::zeros(), *human.get(&Role::Pelvis)?),
+        };
+        at.insert(r, start + turn * v);
+        let frame = match (robot.hinges.get(&r), from) {
+            (Some(h), Some(_)) if std::env::var("NOCLAMP").is_err() => turn * h.clamp(turn.inverse() * c),
+            _ => *c,
+        };
+        frames.insert(r, frame);
+        if r == role {
+            break;
+        }
+    }
+    let own = human.get(&role)?;
+    // A foot or hand keeps the human's frame (the ankle or wrist makes up for a bent knee or
+    // elbow); a shin or forearm turns with its hinge.
+    let body = at.get(&role)? + frames.get(&role)? * origin;
+    Some(own.inverse() * (body - target))
 }
 
 /// A written table row: robot body, human joint, position and rotation weights, offsets.
@@ -377,6 +742,10 @@ pub fn derive(
     source: &str,
 ) -> Result<IkConfig, Error> {
     let robot = robot_side(model, roles);
+    let root_scale = match (robot.paths.get(&Role::Pelvis), human.paths.get(&Role::Pelvis)) {
+        (Some(r), Some(h)) if *h > 0.0 => r / h,
+        _ => 1.0,
+    };
     let mut rows: Vec<Row> = Vec::new();
     for role in TABLE_ORDER {
         let (Some((body, relative, offset)), Some(joint), Some(frame), Some(rp), Some(hp)) = (
@@ -396,10 +765,9 @@ pub fn derive(
         };
         let rot = frame * relative;
         let scale = if *hp > 0.0 { rp / hp } else { 1.0 };
-        let mut pos = *offset;
-        if role == Role::Pelvis {
-            pos += rot.inverse() * human.hip_midpoint * scale;
-        }
+        let origin = robot.origins.get(&role).copied().unwrap_or_default();
+        let pos = fitted_offset(&robot, human, role, origin, *relative, root_scale, scale)
+            .unwrap_or(*offset);
         rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale });
     }
     let text = config_json(&rows, human.height);
@@ -407,10 +775,19 @@ pub fn derive(
 }
 
 /// A role-named config ([`derive()`] against [`HumanBody::canonical`]) bound to `human` (see
-/// the module docs). Entries whose human name is not a role, or whose role the skeleton
-/// lacks, are errors naming them.
-pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
+/// the module docs) on `model` (with its `roles`). Entries whose human name is not a role, or
+/// whose role the skeleton lacks, are errors naming them.
+pub fn bind(
+    config: &IkConfig,
+    human: &HumanBody,
+    model: &Model,
+    roles: &RobotRoles,
+) -> Result<IkConfig, Error> {
     let canonical = HumanBody::canonical();
+    let robot = robot_side(model, roles);
+    let frames = &robot.frames;
+    let mut data = Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
     let role_of = |name: &str| {
         Role::from_name(name).ok_or_else(|| Error::Config {
             at: config.source.clone(),
@@ -430,6 +807,9 @@ pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
         let role = role_of(name)?;
         Ok(config.scale_of(name).unwrap_or(1.0) * factor(role)?)
     };
+    let root_name = Role::Pelvis.name();
+    let canonical_root = config.scale_of(root_name).unwrap_or(1.0);
+    let bound_root = scale_of(root_name)?;
     let mut rows = Vec::new();
     let mut seen = Vec::new();
     for e in config.ik_match_table1.iter().chain(&config.ik_match_table2) {
@@ -442,10 +822,20 @@ pub fn bind(config: &IkConfig, human: &HumanBody) -> Result<IkConfig, Error> {
         let frame = human.frame_offsets.get(&role).ok_or_else(|| missing(role))?;
         let rot = frame * e.rot_offset;
         let scale = scale_of(&e.human_body)?;
-        let mut pos = e.pos_offset;
-        if role == Role::Pelvis {
-            pos += rot.inverse() * human.hip_midpoint * scale;
-        }
+        // The offset fitted to the canonical human is replaced by the one fitted to this
+        // human; what the file adds to it (an edit) is kept.
+        let origin = match (model.body_id(&e.robot_body), roles.roles.get(&role), frames.get(&role)) {
+            (Some(b), Some(r), Some(c)) => Some(c.inverse() * (data.xpos[b] - r.point)),
+            _ => None,
+        };
+        let written = config.scale_of(&e.human_body).unwrap_or(1.0);
+        let fit = |h: &HumanBody, root: f64, s: f64| {
+            fitted_offset(&robot, h, role, origin?, e.rot_offset, root, s)
+        };
+        let pos = match (fit(&canonical, canonical_root, written), fit(human, bound_root, scale)) {
+            (Some(c), Some(h)) => e.pos_offset + h - c,
+            _ => e.pos_offset,
+        };
         rows.push((
             e.clone(),
             Row { role, body: e.robot_body.clone(), joint: joint.clone(), rot, pos, scale },
@@ -674,7 +1064,8 @@ pub fn choose(
             return Ok(Chosen { config, choice: Choice::Given, summary });
         }
         let human = human_body(bvh, fk_options, "the skeleton")?;
-        let bound = bind(&config, &human)?;
+        let roles = RobotRoles::recognise(model)?;
+        let bound = bind(&config, &human, model, &roles)?;
         let summary = format!("config {} (role-named), bound to the skeleton", config.source);
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }

@@ -40,7 +40,7 @@ fn binding_a_role_named_config_equals_deriving_for_the_skeleton() {
         let canonical = derive::derive(&model, &roles, &HumanBody::canonical(), "c").unwrap();
         assert!(derive::is_role_named(&canonical), "{key}");
         let written = IkConfig::from_json_str(canonical.json(), "written").unwrap();
-        let bound = derive::bind(&written, &human).unwrap();
+        let bound = derive::bind(&written, &human, &model, &roles).unwrap();
         let direct = derive::derive(&model, &roles, &human, "d").unwrap();
         assert!(!derive::is_role_named(&direct), "{key}");
         assert!((bound.human_height_assumption - direct.human_height_assumption).abs() < 1e-6);
