@@ -244,6 +244,29 @@ impl Model {
         }
     }
 
+    /// [`Model::jac`] at the origin of `body`, writing only the columns of the dofs on the
+    /// body's path to the world (the others keep what they held): for callers that read just
+    /// those columns ([`Model::body_dofs`]) and call it in a tight loop.
+    pub fn jac_chain(&self, data: &Data, body: usize, jacp: &mut [f64], jacr: &mut [f64]) {
+        let nv = self.nv;
+        let Some(point) = data.xpos.get(body).copied() else { return };
+        if jacp.len() < 3 * nv || jacr.len() < 3 * nv || data.dof_axis.len() != nv {
+            return;
+        }
+        for d in self.body_dofs(body) {
+            let axis = data.dof_axis[d];
+            let (p, r) = if data.dof_linear[d] {
+                (axis, Vector3::zeros())
+            } else {
+                (axis.cross(&(point - data.dof_anchor[d])), axis)
+            };
+            for k in 0..3 {
+                jacp[k * nv + d] = p[k];
+                jacr[k * nv + d] = r[k];
+            }
+        }
+    }
+
     /// `mj_integratePos`: `qpos ← qpos ⊕ qvel dt`. Hinge and slide add; ball and the free
     /// joint's rotation apply the quaternion exponential of the body-frame angular velocity
     /// (`mju_quatIntegrate`); the free joint's translation adds the world-frame velocity.

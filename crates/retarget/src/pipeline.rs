@@ -118,7 +118,7 @@ impl Default for PlausibleOptions {
             self_collision: SelfCollisionMode::On,
             smoothing_passes: 1,
             repair_weight: 1000.0,
-            repair_steps: 2,
+            repair_steps: 1,
             max_extra_steps: 10,
         }
     }
@@ -388,6 +388,11 @@ impl<'a> Prepared<'a> {
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
+        // With a repair pass, the first pass tracks with joint ranges and speed limits only
+        // (box bounds: the fast QP); the repair pass holds the ground and self-collision.
+        if passes > 0 {
+            solver.hold_constraints(false);
+        }
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt));
@@ -402,6 +407,7 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(p) = &self.options.mode {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
+                solver.hold_constraints(true);
                 solver.set_qpos(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;

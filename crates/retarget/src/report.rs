@@ -42,13 +42,16 @@
 //!   holosoma's `penetration_tolerance`, strict `>`); the **duration** is penetrating frames /
 //!   frames; the **max depth** is over all frames.
 //! - **Skating** (needs the source's foot contacts): a foot's speed at frame t is
-//!   `|xy[t] − xy[t−1]| · fps` of its body origin, 0 at frame 0 (holosoma: backward
+//!   `|xy[t] − xy[t−1]| · fps` of its toe point ([`crate::feet::RobotFoot::toe_point`]: the
+//!   middle of the sole's front bottom edge; the body origin when the foot has no collision
+//!   primitive), 0 at frame 0 (holosoma: backward
 //!   differences with a leading 0). A foot **skates** in a frame when the source foot is in
 //!   contact and its speed exceeds [`ReportOptions::skate_speed`] (0.3 m/s: holosoma's strict
 //!   threshold; its legacy one is 0.01 m per frame at its 30 fps). The **duration** is frames
 //!   with a skating foot / frames with a foot in source contact (holosoma counts frames, either
 //!   foot, not foot samples); the **max speed** is over skating samples. Holosoma tracks a toe
-//!   body (`*_ankle_roll_sphere_5_link` on its G1); we track the foot body.
+//!   body (`*_ankle_roll_sphere_5_link` on its G1, a sphere at the front of the sole); the toe
+//!   point is our equivalent on any robot (a foot rolling onto its toes keeps it still).
 //! - **Stance** (needs the source's foot contacts; not in holosoma): over the foot × frame
 //!   samples where the source foot is in contact, the share where the foot height `h` (above)
 //!   is above [`ReportOptions::stance_float_height`] (2 cm: **floating in stance**) and the
@@ -345,7 +348,16 @@ pub fn report(
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
     let (ground_penetration, self_collision) = collisions(motion, model, opts);
-    let foot_xy = feet.map(|f| (0..frames).map(|t| poses.pos(t, f - 1).xy()).collect::<Vec<_>>());
+    // Skating is measured at the toe point of the sole (holosoma: a toe body), else at the
+    // foot body's origin.
+    let toe = feet.map(|f| {
+        crate::feet::RobotFoot::new(model, f, f, 0, None)
+            .map_or(nalgebra::Vector3::zeros(), |r| r.toe_point())
+    });
+    let foot_xy: [Vec<nalgebra::Vector2<f64>>; 2] = std::array::from_fn(|i| {
+        let b = feet[i] - 1;
+        (0..frames).map(|t| (poses.pos(t, b) + (poses.quat(t, b) * toe[i])).xy()).collect()
+    });
     let contacts = motion.contacts.as_ref().map(|c| [&c.left[..], &c.right[..]]);
     Ok(QualityReport {
         robot: model.name.clone(),
