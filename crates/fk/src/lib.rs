@@ -40,7 +40,7 @@ mod trig;
 pub use error::Error;
 pub use forward::{PositionChannels, PositionReading};
 pub use frames::canonical_frames;
-pub use motion::HumanMotion;
+pub use motion::{HumanMotion, MAX_DISTANCE, MAX_STEP};
 pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
 pub use roles::{
     Humanoid, Part, Reference, RestPose, Role, RoleJoint, RoleMap, Rule, Side, UpAxis,
@@ -150,9 +150,13 @@ fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
 }
 
 /// Forward kinematics of every frame of `bvh`, converted to our world (see [`FkOptions`]).
+/// A clip without frames, or whose poses are absurd ([`HumanMotion::validate`]), is an error.
 pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkReport), Error> {
     let plan = Plan::new(bvh)?;
     let fps = frames_per_second(bvh)?;
+    if bvh.motion.num_frames == 0 {
+        return Err(Error::NoFrames);
+    }
     check_finite(bvh)?;
     let joint_names: Vec<String> = bvh.skeleton.joints.iter().map(|j| j.name.clone()).collect();
     let derived = resolve_derived(&joint_names, &options.derived)?;
@@ -188,6 +192,7 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     };
     let rest = rest_pose(&plan, &world);
     let motion = HumanMotion { fps, body_names, num_frames, positions, orientations };
+    motion.validate()?;
     let frames = (0..num_frames).map(|f| &motion.frame_positions(f)[..num_joints]);
     let stature = size::stature(frames, &rest, &landmarks);
     let (height, height_source) = match options.height {
@@ -475,7 +480,9 @@ mod tests {
             let bvh = random_bvh(&mut rng, num_joints, 8);
             let options = FkOptions {
                 axes: axes[case % axes.len()],
-                units: UnitChoice::Scale([0.01, 1.0, 0.05644][case % 3]),
+                // Random channels in metres would teleport bodies by hundreds of metres per frame,
+                // which `HumanMotion::validate` rightly refuses: file units are cm, mm, CMU's.
+                units: UnitChoice::Scale([0.01, 0.001, 0.05644][case % 3]),
                 ..FkOptions::default()
             };
             let (motion, report) = human_motion(&bvh, &options).unwrap();

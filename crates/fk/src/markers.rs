@@ -40,6 +40,12 @@ pub enum MarkerError {
     InvalidOption { name: &'static str, value: f64 },
     #[error("body `{body}`, frame {frame}: frame markers are collinear or coincide")]
     DegenerateFrame { body: String, frame: usize },
+    /// A marker absurdly far from the origin (more than [`crate::MAX_DISTANCE`] in metres).
+    #[error("frame {frame}: marker `{marker}` is {distance:.3e} m from the origin (more than {} km): a corrupt value or a wrong unit", crate::MAX_DISTANCE / 1e3)]
+    AbsurdMarker { frame: usize, marker: String, distance: f64 },
+    /// The virtual bodies' motion fails [`HumanMotion::validate`].
+    #[error(transparent)]
+    Motion(#[from] crate::Error),
 }
 
 /// The rotation taking a lab frame to ours (Z up): `"z-up"` (identity) or `"y-up"`
@@ -55,10 +61,12 @@ pub fn axes_rotation(name: &str) -> Option<UnitQuaternion<f64>> {
     }
 }
 
-/// Marker data converted to our world: per frame, per label, metres and Z up.
+/// Marker data converted to our world: per frame, per label, metres and Z up. Non-finite
+/// coordinates count as occluded; a finite one farther than [`crate::MAX_DISTANCE`] is an
+/// error naming the frame and marker.
 fn to_world(
     frames: &[Vec<Option<[f64; 3]>>],
-    num_labels: usize,
+    labels: &[String],
     metres_per_unit: f64,
     axes: &UnitQuaternion<f64>,
 ) -> Result<Vec<Vec<Option<Vector3<f64>>>>, MarkerError> {
@@ -69,16 +77,28 @@ fn to_world(
         .iter()
         .enumerate()
         .map(|(f, row)| {
-            if row.len() != num_labels {
-                return Err(MarkerError::Shape { frame: f, got: row.len(), expected: num_labels });
+            if row.len() != labels.len() {
+                return Err(MarkerError::Shape {
+                    frame: f,
+                    got: row.len(),
+                    expected: labels.len(),
+                });
             }
-            Ok(row
-                .iter()
-                .map(|p| {
-                    p.filter(|p| p.iter().all(|v| v.is_finite()))
-                        .map(|p| axes * (Vector3::from(p) * metres_per_unit))
+            row.iter()
+                .zip(labels)
+                .map(|(p, label)| {
+                    let Some(p) = p.filter(|p| p.iter().all(|v| v.is_finite())) else {
+                        return Ok(None);
+                    };
+                    let p = axes * (Vector3::from(p) * metres_per_unit);
+                    let distance = crate::motion::robust_norm(&p);
+                    if distance <= crate::MAX_DISTANCE {
+                        Ok(Some(p))
+                    } else {
+                        Err(MarkerError::AbsurdMarker { frame: f, marker: label.clone(), distance })
+                    }
                 })
-                .collect())
+                .collect()
         })
         .collect()
 }
@@ -119,6 +139,7 @@ fn find(labels: &[String], body: &str, marker: &str) -> Result<usize, MarkerErro
 
 /// Builds the virtual bodies' motion. `frames[f][p]` is marker `labels[p]` at frame `f`
 /// (file units, lab axes; `None` when occluded). Orientations are made continuous in time.
+/// Absurd marker positions and body motions are errors ([`HumanMotion::validate`]).
 pub fn marker_motion(
     labels: &[String],
     frames: &[Vec<Option<[f64; 3]>>],
@@ -133,7 +154,7 @@ pub fn marker_motion(
     if frames.is_empty() {
         return Err(MarkerError::NoFrames);
     }
-    let world = to_world(frames, labels.len(), metres_per_unit, axes)?;
+    let world = to_world(frames, labels, metres_per_unit, axes)?;
     let nf = frames.len();
     let nb = bodies.len();
     let mut positions = vec![Vector3::zeros(); nf * nb];
@@ -182,13 +203,15 @@ pub fn marker_motion(
             previous = Some(q);
         }
     }
-    Ok(HumanMotion {
+    let motion = HumanMotion {
         fps,
         body_names: bodies.iter().map(|b| b.name.clone()).collect(),
         num_frames: nf,
         positions,
         orientations,
-    })
+    };
+    motion.validate()?;
+    Ok(motion)
 }
 
 /// The orientation of the triad `a b c` (module docs); `None` when degenerate.
@@ -213,7 +236,7 @@ pub fn marker_height(
     top: &[String],
     bottom: &[String],
 ) -> Result<Option<f64>, MarkerError> {
-    let world = to_world(frames, labels.len(), metres_per_unit, axes)?;
+    let world = to_world(frames, labels, metres_per_unit, axes)?;
     let top: Vec<usize> =
         top.iter().map(|m| find(labels, "height", m)).collect::<Result<_, _>>()?;
     let bottom: Vec<usize> =
@@ -293,6 +316,33 @@ mod tests {
             marker_motion(&l, &never, 100.0, 0.001, &id, &only_a),
             Err(MarkerError::NeverSeen { .. })
         ));
+    }
+
+    #[test]
+    fn absurd_markers_and_jumps_are_errors_naming_the_frame() {
+        let l = labels(&["A", "B"]);
+        let id = UnitQuaternion::identity();
+        let bodies = vec![MarkerBody { name: "AB".into(), markers: l.clone(), frame: None }];
+        let mut frames = vec![vec![Some([0.0, 0.0, 1000.0]), Some([100.0, 0.0, 1000.0])]; 4];
+        assert!(marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).is_ok());
+        // 1e300 mm: a corrupt number, named with its frame and marker.
+        frames[2][1] = Some([1e300, 0.0, 0.0]);
+        let err = marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).unwrap_err();
+        assert!(
+            matches!(&err, MarkerError::AbsurdMarker { frame: 2, marker, .. } if marker == "B"),
+            "{err:?}"
+        );
+        assert!(err.to_string().starts_with("frame 2: marker `B` is 1.000e297 m"), "{err}");
+        // 1 km in one frame (within the distance bound): the body's motion is refused.
+        frames[2][1] = Some([2e6, 0.0, 1000.0]);
+        let err = marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).unwrap_err();
+        assert!(
+            matches!(&err, MarkerError::Motion(crate::Error::AbsurdStep { frame: 2, body, .. }) if body == "AB"),
+            "{err:?}"
+        );
+        // Non-finite values are occlusions, as before.
+        frames[2][1] = Some([f64::NAN, 0.0, 0.0]);
+        assert!(marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).is_ok());
     }
 
     #[test]
