@@ -81,7 +81,11 @@ pub(crate) fn write_npz<W: Write + Seek>(out: W, arrays: &[(&str, Array)]) -> st
     Ok(())
 }
 
-/// Every `<key>.npy` of an `.npz`, by key.
+/// Deflate's largest expansion: 258 bytes from a 2-bit code, i.e. about 1032 to 1 (zlib's
+/// technical details, "Maximum compression factor").
+const MAX_DEFLATE_RATIO: u64 = 1032;
+
+/// Every `<key>.npy` of an `.npz`, by key. Allocations are bounded by the file's size.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
     let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
     let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
@@ -91,8 +95,24 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
         let Some(key) = member.name().strip_suffix(".npy").map(str::to_owned) else { continue };
-        let mut bytes = Vec::with_capacity(usize::try_from(member.size()).unwrap_or(0));
-        member.read_to_end(&mut bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
+        // The declared size is the file's word: believe it only as far as the compressed
+        // bytes can hold (deflate expands at most 1032:1), and never read past it.
+        let (size, packed) = (member.size(), member.compressed_size());
+        let bound = match member.compression() {
+            zip::CompressionMethod::Stored => packed,
+            _ => packed.saturating_mul(MAX_DEFLATE_RATIO).saturating_add(1024),
+        };
+        if size > bound {
+            return Err(read_error(format!(
+                "{key}: member claims {size} bytes from {packed} stored bytes"
+            )));
+        }
+        let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
+        member
+            .by_ref()
+            .take(size)
+            .read_to_end(&mut bytes)
+            .map_err(|e| read_error(format!("{key}: {e}")))?;
         let array = npy::decode(&bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
         arrays.insert(key, array);
     }
