@@ -139,7 +139,8 @@ impl Analog {
     /// One channel over time.
     pub fn channel(&self, channel: usize) -> impl Iterator<Item = f32> + '_ {
         let n = self.channel_count();
-        let data: &[f32] = if channel < n { &self.data[channel..] } else { &[] };
+        // With no samples (a file of 0 frames) `data` is empty while `channel < n`.
+        let data: &[f32] = if channel < n { self.data.get(channel..).unwrap_or(&[]) } else { &[] };
         data.iter().step_by(n.max(1)).copied()
     }
 }

@@ -87,10 +87,15 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// Every `<key>.npy` of an `.npz`, by key. Allocations are bounded by the file's size.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
-    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
     let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    read_npz_from(file, path)
+}
+
+/// [`read_npz`] on any reader; `path` names it in errors.
+fn read_npz_from<R: Read + Seek>(reader: R, path: &Path) -> Result<BTreeMap<String, Array>, Error> {
+    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
     let mut zip =
-        zip::ZipArchive::new(file).map_err(|e| read_error(format!("not an .npz: {e}")))?;
+        zip::ZipArchive::new(reader).map_err(|e| read_error(format!("not an .npz: {e}")))?;
     let mut arrays = BTreeMap::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
@@ -124,7 +129,15 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
 /// `target_body_names`, `target_pos` (T×K×3), `target_quat` (T×K×4, w first), and
 /// `contact_left`, `contact_right` (T bools)).
 pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
-    let arrays = read_npz(path)?;
+    motion_from_arrays(&read_npz(path)?, path)
+}
+
+/// [`read_motion_npz`] on the bytes of an `.npz` (`name` is used in errors).
+pub fn read_motion_npz_bytes(bytes: &[u8], name: &Path) -> Result<RobotMotion, Error> {
+    motion_from_arrays(&read_npz_from(std::io::Cursor::new(bytes), name)?, name)
+}
+
+fn motion_from_arrays(arrays: &BTreeMap<String, Array>, path: &Path) -> Result<RobotMotion, Error> {
     let err = |message: String| Error::Read { path: path.to_path_buf(), message };
     let get = |key: &str| arrays.get(key).ok_or_else(|| err(format!("no `{key}` array")));
     let fps = match floats(get("fps")?) {
