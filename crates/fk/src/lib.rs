@@ -24,6 +24,9 @@
 //!
 //! `fk` does no IO, never prints and never panics on input.
 
+// Library code never panics on input (issue 15): the compiler checks it. Tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 pub mod conventions;
 mod error;
 mod forward;
@@ -143,7 +146,8 @@ fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
         .enumerate()
         .map(|(k, &f)| {
             let range = k * joints..(k + 1) * joints;
-            (f, positions[range.clone()].to_vec(), orientations[range].to_vec())
+            let p = positions.get(range.clone()).unwrap_or_default();
+            (f, p.to_vec(), orientations.get(range).unwrap_or_default().to_vec())
         })
         .collect();
     roles::Samples { rest: rest_pose(plan, &file), frames }
@@ -193,7 +197,10 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     let rest = rest_pose(&plan, &world);
     let motion = HumanMotion { fps, body_names, num_frames, positions, orientations };
     motion.validate()?;
-    let frames = (0..num_frames).map(|f| &motion.frame_positions(f)[..num_joints]);
+    let frames = (0..num_frames).map(|f| {
+        let all = motion.frame_positions(f);
+        all.get(..num_joints).unwrap_or(all)
+    });
     let stature = size::stature(frames, &rest, &landmarks);
     let (height, height_source) = match options.height {
         Some(h) => (h, "given".to_owned()),
@@ -249,9 +256,10 @@ fn check_finite(bvh: &Bvh) -> Result<(), Error> {
         frame,
         joint: joint.map(|j| j.name.clone()).unwrap_or_default(),
         channel: joint
-            .map(|j| j.channels[column - j.first_channel].name().to_owned())
+            .and_then(|j| j.channels.get(column - j.first_channel))
+            .map(|c| c.name().to_owned())
             .unwrap_or_default(),
-        value: motion.values[at],
+        value: motion.values.get(at).copied().unwrap_or(f64::NAN),
     })
 }
 
@@ -311,7 +319,7 @@ fn units(
         .offsets()
         .zip(&parents)
         .map(|(offset, parent)| match parent {
-            Some(p) if parents[*p].is_some() => Vector3::from(offset).norm(),
+            Some(p) if parents.get(*p).is_some_and(Option::is_some) => Vector3::from(offset).norm(),
             _ => 0.0,
         })
         .collect();

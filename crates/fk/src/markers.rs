@@ -106,24 +106,24 @@ fn to_world(
 /// Fills the gaps of a per-frame series linearly; holds the first/last value at the ends.
 /// `None` if no frame has a value.
 fn fill_gaps(series: &[Option<Vector3<f64>>]) -> Option<Vec<Vector3<f64>>> {
-    let known: Vec<usize> = (0..series.len()).filter(|&f| series[f].is_some()).collect();
-    let (&first, &last) = (known.first()?, known.last()?);
+    let known: Vec<(usize, Vector3<f64>)> =
+        series.iter().enumerate().filter_map(|(f, v)| Some((f, (*v)?))).collect();
+    let (&(first, at_first), &(last, at_last)) = (known.first()?, known.last()?);
     let mut out = Vec::with_capacity(series.len());
     let mut next = 0; // index into `known` of the first known frame >= f
-    for f in 0..series.len() {
-        while known[next] < f && next + 1 < known.len() {
+    for (f, value) in series.iter().enumerate() {
+        while known.get(next).is_some_and(|&(k, _)| k < f) && next + 1 < known.len() {
             next += 1;
         }
-        let v = if let Some(v) = series[f] {
-            v
-        } else if f < first {
-            series[first].unwrap_or_default()
-        } else if f > last {
-            series[last].unwrap_or_default()
-        } else {
-            let (b, a) = (known[next], known[next - 1]);
-            let t = (f - a) as f64 / (b - a) as f64;
-            series[a].unwrap_or_default() * (1.0 - t) + series[b].unwrap_or_default() * t
+        let v = match (value, known.get(next.wrapping_sub(1)), known.get(next)) {
+            (Some(v), _, _) => *v,
+            (None, _, _) if f < first => at_first,
+            (None, _, _) if f > last => at_last,
+            (None, Some(&(a, va)), Some(&(b, vb))) => {
+                let t = (f - a) as f64 / (b - a) as f64;
+                va * (1.0 - t) + vb * t
+            }
+            (None, _, _) => at_last,
         };
         out.push(v);
     }
@@ -168,30 +168,35 @@ pub fn marker_motion(
         let centroid: Vec<Option<Vector3<f64>>> = world
             .iter()
             .map(|row| {
-                let present: Vec<Vector3<f64>> = idx.iter().filter_map(|&i| row[i]).collect();
+                let present: Vec<Vector3<f64>> =
+                    idx.iter().filter_map(|&i| row.get(i).copied().flatten()).collect();
                 (!present.is_empty())
                     .then(|| present.iter().sum::<Vector3<f64>>() / present.len() as f64)
             })
             .collect();
         let filled = fill_gaps(&centroid)
             .ok_or_else(|| MarkerError::NeverSeen { body: body.name.clone() })?;
-        for (f, p) in filled.into_iter().enumerate() {
-            positions[f * nb + b] = p;
+        for (slot, p) in positions.iter_mut().skip(b).step_by(nb).zip(filled) {
+            *slot = p;
         }
         let Some(frame) = &body.frame else { continue };
-        let mut tracks = Vec::with_capacity(3);
+        let mut tracks: Vec<Vec<Vector3<f64>>> = Vec::with_capacity(3);
         for m in frame {
             let i = find(labels, &body.name, m)?;
-            let series: Vec<Option<Vector3<f64>>> = world.iter().map(|row| row[i]).collect();
+            let series: Vec<Option<Vector3<f64>>> =
+                world.iter().map(|row| row.get(i).copied().flatten()).collect();
             tracks.push(fill_gaps(&series).ok_or_else(|| MarkerError::FrameMarkerNeverSeen {
                 body: body.name.clone(),
                 marker: m.clone(),
             })?);
         }
+        let [ta, tb, tc] = tracks.as_slice() else { continue };
         let mut previous: Option<UnitQuaternion<f64>> = None;
-        for f in 0..nf {
-            let q = triad(&tracks[0][f], &tracks[1][f], &tracks[2][f]).ok_or_else(|| {
-                MarkerError::DegenerateFrame { body: body.name.clone(), frame: f }
+        let slots = orientations.iter_mut().skip(b).step_by(nb);
+        for (f, (((a, bb), c), slot)) in ta.iter().zip(tb).zip(tc).zip(slots).enumerate() {
+            let q = triad(a, bb, c).ok_or_else(|| MarkerError::DegenerateFrame {
+                body: body.name.clone(),
+                frame: f,
             })?;
             let q = match previous {
                 Some(p) if p.coords.dot(&q.coords) < 0.0 => {
@@ -199,7 +204,7 @@ pub fn marker_motion(
                 }
                 _ => q,
             };
-            orientations[f * nb + b] = q;
+            *slot = q;
             previous = Some(q);
         }
     }
@@ -243,18 +248,25 @@ pub fn marker_height(
         bottom.iter().map(|m| find(labels, "height", m)).collect::<Result<_, _>>()?;
     let mut tops: Vec<f64> = world
         .iter()
-        .filter_map(|row| top.iter().filter_map(|&i| row[i].map(|p| p.z)).reduce(f64::max))
+        .filter_map(|row| {
+            top.iter().filter_map(|&i| row.get(i).copied().flatten().map(|p| p.z)).reduce(f64::max)
+        })
         .collect();
     let floor = world
         .iter()
-        .filter_map(|row| bottom.iter().filter_map(|&i| row[i].map(|p| p.z)).reduce(f64::min))
+        .filter_map(|row| {
+            bottom
+                .iter()
+                .filter_map(|&i| row.get(i).copied().flatten().map(|p| p.z))
+                .reduce(f64::min)
+        })
         .reduce(f64::min);
     let Some(floor) = floor else { return Ok(None) };
     if tops.is_empty() {
         return Ok(None);
     }
     tops.sort_by(f64::total_cmp);
-    Ok(Some(tops[tops.len() / 2] - floor))
+    Ok(tops.get(tops.len() / 2).map(|top| top - floor))
 }
 
 #[cfg(test)]

@@ -51,25 +51,33 @@ impl HumanMotion {
 
     /// World position of `body` at `frame` (metres, Z up). Panics if either is out of range.
     #[must_use]
+    // A caller's out-of-range index is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn position(&self, frame: usize, body: usize) -> &Vector3<f64> {
         &self.positions[self.slot(frame, body)]
     }
 
     /// World orientation of `body` at `frame`. Panics if either is out of range.
     #[must_use]
+    // A caller's out-of-range index is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn orientation(&self, frame: usize, body: usize) -> &UnitQuaternion<f64> {
         &self.orientations[self.slot(frame, body)]
     }
 
-    /// All bodies' positions at `frame`, indexed by body.
+    /// All bodies' positions at `frame`, indexed by body. Panics if `frame` is out of range.
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn frame_positions(&self, frame: usize) -> &[Vector3<f64>] {
         let n = self.num_bodies();
         &self.positions[frame * n..(frame + 1) * n]
     }
 
-    /// All bodies' orientations at `frame`, indexed by body.
+    /// All bodies' orientations at `frame`, indexed by body. Panics if `frame` is out of range.
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn frame_orientations(&self, frame: usize) -> &[UnitQuaternion<f64>] {
         let n = self.num_bodies();
         &self.orientations[frame * n..(frame + 1) * n]
@@ -110,12 +118,12 @@ impl HumanMotion {
                     return Err(Error::NonFinitePose { frame, body: body(k) });
                 }
                 let distance = robust_norm(p);
-                if !(distance <= MAX_DISTANCE) {
+                if distance > MAX_DISTANCE {
                     return Err(Error::AbsurdPosition { frame, body: body(k), distance });
                 }
                 let step =
                     previous.and_then(|before| before.get(k)).map_or(0.0, |b| (p - b).norm());
-                if !(step <= MAX_STEP) {
+                if step > MAX_STEP {
                     return Err(Error::AbsurdStep { frame, body: body(k), step });
                 }
             }

@@ -98,17 +98,13 @@ fn reduced_sin_cos(x: f64) -> (f64, f64) {
 /// `sin` and `cos`. One tight loop the compiler vectorizes, then a scalar pass for the rare
 /// huge or non-finite argument.
 pub(crate) fn half_angles_sin_cos(degrees: &[f64], sin: &mut [f64], cos: &mut [f64]) {
-    let n = degrees.len().min(sin.len()).min(cos.len());
-    let (values, sin, cos) = (&degrees[..n], &mut sin[..n], &mut cos[..n]);
-    for i in 0..n {
-        let (s, c) = reduced_sin_cos(values[i].to_radians() / 2.0);
-        sin[i] = s;
-        cos[i] = c;
+    for ((v, s), c) in degrees.iter().zip(sin.iter_mut()).zip(cos.iter_mut()) {
+        (*s, *c) = reduced_sin_cos(v.to_radians() / 2.0);
     }
-    for i in 0..n {
-        let x = values[i].to_radians() / 2.0;
+    for ((v, s), c) in degrees.iter().zip(sin.iter_mut()).zip(cos.iter_mut()) {
+        let x = v.to_radians() / 2.0;
         if !in_range(x) {
-            (sin[i], cos[i]) = x.sin_cos();
+            (*s, *c) = x.sin_cos();
         }
     }
 }

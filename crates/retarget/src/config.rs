@@ -13,6 +13,9 @@
 //! serde_json; names that exist in neither the robot nor the human skeleton are reported by
 //! [`IkConfig::validate`] with the position of the name in the file and the nearest names.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::fmt;
 use std::path::Path;
 

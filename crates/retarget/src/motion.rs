@@ -1,5 +1,8 @@
 //! The retargeter's output: robot configurations over time, plus what they tracked.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// The world targets the solver tracked, per frame and per target body.

@@ -62,6 +62,9 @@
 //!   [`mjcf::Joint::velocity_limit`], frames × joints with `|q̇| > limit` (`q̇` as above) and the
 //!   largest `|q̇| / limit`; `None` when no joint has a limit.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::fmt;
 
 use serde::Serialize;

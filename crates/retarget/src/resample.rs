@@ -6,6 +6,9 @@
 //! output frame is the last one at or before the source's last frame, so nothing is
 //! extrapolated.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use mjcf::{JointType, Model};
 use nalgebra::{Quaternion, UnitQuaternion};
 

@@ -16,6 +16,9 @@
 //! exactly as in GMR. A scaled body with no active table-1 entry (GMR raises `KeyError`)
 //! gets no offset here.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;

@@ -1,6 +1,9 @@
 //! Quantities derived from `qpos`: world body poses (forward kinematics) and finite-difference
 //! velocities, shared by the writers and the quality report.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::motion::RobotMotion;

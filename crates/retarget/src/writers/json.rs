@@ -13,6 +13,9 @@
 //! }
 //! ```
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::io::Write;
 
 use serde_json::json;

@@ -9,6 +9,9 @@
 //! then renamed over it. On error the temporary file is removed, so an interrupted or failed
 //! run never leaves a half-written file under the final name.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 mod csv;
 mod derived;
 mod json;

@@ -4,6 +4,9 @@
 //! (`<U`n: n UTF-32LE code units per element, NUL-padded) arrays, as `numpy.save` does, and
 //! read those plus `<f4`, `<i4`, `<i8` (converted to `f64`).
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 const MAGIC: &[u8] = b"\x93NUMPY";
 
 /// Array contents.

@@ -1,6 +1,9 @@
 //! `.npz`: numpy's zip archive of `<key>.npy` members (as `numpy.savez_compressed` writes it:
 //! deflate), and the reader for our own files.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{Read, Seek, Write};

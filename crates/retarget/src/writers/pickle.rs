@@ -12,6 +12,9 @@
 //! `ndarray.__setstate__`. `numpy.ndarray` and `numpy.dtype` resolve the same on numpy 1.x
 //! and 2.x (unlike `numpy.core.multiarray._reconstruct`, which numpy 2 moved to `numpy._core`).
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, Error};
 use crate::motion::RobotMotion;
 
