@@ -5,7 +5,7 @@ use std::io::{Read, Seek, SeekFrom};
 use crate::header::{Header, BLOCK, KEY};
 use crate::layout::{DataFormat, Layout};
 use crate::params::{self, Parameters};
-use crate::processor::{take as bytes, Processor};
+use crate::processor::{take as word_bytes, Processor};
 use crate::Error;
 
 /// One marker sample. Invalid samples (residual word −1) are `None` in [`Frame::points`].
@@ -162,8 +162,8 @@ pub(crate) fn decode_frame(layout: &Layout, bytes: &[u8], frame: &mut Frame) {
     let word = layout.word_size();
     let (point_bytes, analog_bytes) = bytes.split_at(4 * word * layout.point_count);
     let value = |c: &[u8]| match layout.format {
-        DataFormat::Integer => f32::from(p.i16(bytes(c))),
-        DataFormat::Float => p.f32(bytes(c)),
+        DataFormat::Integer => f32::from(p.i16(word_bytes(c))),
+        DataFormat::Float => p.f32(word_bytes(c)),
     };
     let at = |c: &[u8], k: usize| value(c.get(k * word..).unwrap_or_default());
     let scale = layout.point_scale.abs();
@@ -176,9 +176,9 @@ pub(crate) fn decode_frame(layout: &Layout, bytes: &[u8], frame: &mut Frame) {
     frame.analog.clear();
     frame.analog.extend(analog_bytes.chunks_exact(word).enumerate().map(|(i, c)| {
         let raw = match layout.format {
-            DataFormat::Integer if layout.analog_unsigned => f64::from(p.u16(bytes(c))),
-            DataFormat::Integer => f64::from(p.i16(bytes(c))),
-            DataFormat::Float => f64::from(p.f32(bytes(c))),
+            DataFormat::Integer if layout.analog_unsigned => f64::from(p.u16(word_bytes(c))),
+            DataFormat::Integer => f64::from(p.i16(word_bytes(c))),
+            DataFormat::Float => f64::from(p.f32(word_bytes(c))),
         };
         let ch = i % channels;
         // `Layout` holds one scale and offset per channel.

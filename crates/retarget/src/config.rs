@@ -227,7 +227,7 @@ impl IkConfig {
                     ),
                 ));
             }
-            if let Some(other) = active[..i].iter().find(|o| o.human_body == e.human_body) {
+            if let Some(other) = active.iter().take(i).find(|o| o.human_body == e.human_body) {
                 return Err(self.invalid(
                     &e.robot_body,
                     format!(
@@ -341,15 +341,20 @@ fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+        // row[j] is the distance of a[..i] to b[..j]; `left` is the new row's previous entry.
+        let mut prev = i;
+        let mut left = i + 1;
+        for (slot, cb) in row.iter_mut().skip(1).zip(&b) {
+            let cur = *slot;
+            left = (prev + usize::from(ca != *cb)).min(left + 1).min(cur + 1);
+            *slot = left;
             prev = cur;
         }
+        if let Some(first) = row.first_mut() {
+            *first = i + 1;
+        }
     }
-    row[b.len()]
+    row.last().copied().unwrap_or(0)
 }
 
 #[cfg(test)]

@@ -101,7 +101,11 @@ impl TargetMap {
     }
 
     /// Targets of one frame: `positions`/`orientations` are all human bodies of the frame
-    /// (indexed like the motion), `out` gets one pose per scaled body.
+    /// (indexed like the motion), `out` gets one pose per scaled body. Panics if they hold
+    /// fewer bodies than the motion the map was made for.
+    // `bodies[..].human` index the motion's bodies the map was built from (`new` resolved them
+    // by name) and `root` indexes `bodies`: a shorter slice is a caller's bug.
+    #[allow(clippy::indexing_slicing)]
     pub fn compute(
         &self,
         positions: &[Vector3<f64>],

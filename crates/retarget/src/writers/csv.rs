@@ -29,7 +29,7 @@ pub(crate) fn write_csv<W: Write>(
         line.clear();
         let (pos, wxyz) = root_pose(motion, model, &poses, t);
         let xyzw = xyzw_from_wxyz(wxyz);
-        let values = pos.iter().chain(&xyzw).chain(&motion.frame(t)[skip..]);
+        let values = pos.iter().chain(&xyzw).chain(motion.frame(t).get(skip..).unwrap_or_default());
         for (i, v) in values.enumerate() {
             if i > 0 {
                 line.push(',');

@@ -160,7 +160,8 @@ pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<
     }
     if let Some(i) = motion.qpos.iter().position(|v| !v.is_finite()) {
         let (frame, index) = (i / motion.nq, i % motion.nq);
-        return Err(Error::NonFinite { frame, index, value: motion.qpos[i] });
+        let value = motion.qpos.get(i).copied().unwrap_or(f64::NAN);
+        return Err(Error::NonFinite { frame, index, value });
     }
     if let Some(t) = &motion.targets {
         let expected = motion.num_frames() * t.body_names.len();
@@ -193,8 +194,10 @@ pub(crate) fn root_pose(
     frame: usize,
 ) -> ([f64; 3], [f64; 4]) {
     if root_nq(model) == 7 {
-        let q = motion.frame(frame);
-        ([q[0], q[1], q[2]], [q[3], q[4], q[5], q[6]])
+        match motion.frame(frame) {
+            &[x, y, z, w, i, j, k, ..] => ([x, y, z], [w, i, j, k]),
+            _ => ([0.0; 3], [1.0, 0.0, 0.0, 0.0]),
+        }
     } else {
         let p = poses.pos(frame, 0);
         let q = poses.quat(frame, 0);

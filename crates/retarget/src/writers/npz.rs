@@ -33,7 +33,9 @@ pub(crate) fn motion_arrays(
     }
     let skip = root_nq(model);
     let cols = motion.nq - skip;
-    let joint_pos: Vec<f64> = (0..frames).flat_map(|t| motion.frame(t)[skip..].to_vec()).collect();
+    let joint_pos: Vec<f64> = (0..frames)
+        .flat_map(|t| motion.frame(t).get(skip..).unwrap_or_default().to_vec())
+        .collect();
     let joint_vel = gradient_rows(&joint_pos, cols, dt);
     arrays.push(("joint_pos", Array::f64(vec![frames, cols], joint_pos)));
     arrays.push(("joint_vel", Array::f64(vec![frames, cols], joint_vel)));
@@ -199,11 +201,14 @@ fn read_targets(
             pos.shape, quat.shape
         ));
     }
-    let pos = p.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
+    let pos = p.chunks_exact(3).map(Vector3::from_column_slice).collect();
     let quat = q
         .chunks_exact(4)
         .map(|c| {
-            let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+            let &[w, x, y, z] = c else {
+                return Err("a target quaternion has not 4 numbers".to_owned());
+            };
+            let q = Quaternion::new(w, x, y, z);
             match q.norm() {
                 n if (n - 1.0).abs() < 1e-9 => Ok(UnitQuaternion::new_unchecked(q)),
                 n if n > 1e-9 && n.is_finite() => Ok(UnitQuaternion::new_normalize(q)),

@@ -55,7 +55,9 @@ pub(crate) fn motion_pickle(motion: &RobotMotion, model: &mjcf::Model) -> Result
             local.extend_from_slice(&[v.x, v.y, v.z]);
         }
     }
-    let dof_pos: Vec<f64> = (0..frames).flat_map(|t| motion.frame(t)[skip..].to_vec()).collect();
+    let dof_pos: Vec<f64> = (0..frames)
+        .flat_map(|t| motion.frame(t).get(skip..).unwrap_or_default().to_vec())
+        .collect();
 
     let mut p = Pickler::default();
     p.out.extend_from_slice(&[PROTO, 3, EMPTY_DICT, MARK]);
