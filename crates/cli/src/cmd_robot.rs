@@ -12,10 +12,14 @@ use crate::shipped;
 #[derive(Subcommand, Debug)]
 pub enum RobotCommand {
     /// Print joints, ranges and bodies of a robot (shipped name, MJCF or URDF path).
-    Info { robot: String },
+    Info {
+        /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
+        robot: String,
+    },
     /// Compare our kinematics with MuJoCo's at random configurations (needs the `mujoco`
     /// feature): model structure, body poses and body Jacobians.
     Check {
+        /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
         robot: String,
         /// Number of random configurations (checked in addition to qpos0).
         #[arg(long, default_value_t = 100)]

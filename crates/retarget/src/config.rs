@@ -173,6 +173,19 @@ impl IkConfig {
         out
     }
 
+    /// Robot bodies whose position is a target: a non-zero position weight in an enabled
+    /// table. The others are tracked for their orientation only.
+    #[must_use]
+    pub fn position_targets(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for e in self.stages().into_iter().flatten() {
+            if e.is_active() && e.pos_weight != 0.0 && !out.contains(&e.robot_body) {
+                out.push(e.robot_body.clone());
+            }
+        }
+        out
+    }
+
     /// Scale of a human body from the table (before the height ratio).
     #[must_use]
     pub fn scale_of(&self, human_body: &str) -> Option<f64> {
