@@ -43,11 +43,11 @@ fn repo_models() -> Vec<(String, PathBuf)> {
     let mut out: Vec<(String, PathBuf)> = entries
         .filter_map(Result::ok)
         .filter(|e| e.path().is_dir())
-        .filter_map(|e| {
+        .map(|e| {
             let key = e.file_name().to_string_lossy().into_owned();
             let xml = e.path().join(format!("{key}.xml"));
             assert!(xml.is_file(), "robots/{key}/ has no {key}.xml");
-            Some((key, xml))
+            (key, xml)
         })
         .collect();
     out.sort();

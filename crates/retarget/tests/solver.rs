@@ -200,7 +200,8 @@ fn root_position_is_in_metres_and_far_targets_stay_finite() {
     let home = Vector3::new(model.qpos0[0], model.qpos0[1], model.qpos0[2]);
     let goal = home + Vector3::new(0.5, -0.3, 0.0);
     let target = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: goal };
-    let mut solver = Solver::new(&model, &[tasks.clone()], SolverOptions::default()).unwrap();
+    let mut solver =
+        Solver::new(&model, std::slice::from_ref(&tasks), SolverOptions::default()).unwrap();
     for _ in 0..30 {
         solver.solve_frame(&[target], 1.0 / 30.0);
     }
