@@ -25,9 +25,10 @@ pub struct BatchArgs {
     /// JSON file.
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
-    /// IK config (GMR schema). Default: the shipped LAFAN1 config of a shipped robot;
-    /// required with a model path as --robot. C3D clips need a marker config (with
-    /// `marker_bodies`, e.g. configs/c3d_plugingait_to_unitree_g1.json).
+    /// IK config (GMR schema) for every clip (bound to each skeleton when role-named);
+    /// default: per clip, GMR's tuned config or one derived from the roles (as without
+    /// --config in the main command). C3D clips need a marker config (with `marker_bodies`,
+    /// e.g. configs/c3d_plugingait_to_unitree_g1.json).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Output format of every clip.
@@ -143,10 +144,14 @@ fn print_table(summary: &Summary) {
     }
 }
 
-/// What every clip of a batch shares: the robot, its config and the options.
+/// What every clip of a batch shares: the robot, the config source and the options.
 struct Job {
     model: mjcf::Model,
-    config: IkConfig,
+    robot: String,
+    /// `--config`, read once.
+    given: Option<IkConfig>,
+    /// The shipped robot's tuned config.
+    tuned: Option<IkConfig>,
     /// The marker part of `--config`, when it has one (needed by C3D clips).
     markers: Option<crate::cmd_retarget::MarkerConfig>,
     config_path: Option<PathBuf>,
@@ -163,8 +168,9 @@ impl Job {
         human_height: Option<f64>,
         format: &str,
     ) -> anyhow::Result<Job> {
+        let given = config.map(IkConfig::from_file).transpose()?;
+        let tuned = crate::cmd_retarget::shipped_config(robot).transpose()?;
         let config_path = config;
-        let config = crate::cmd_retarget::resolve_config(robot, config)?;
         let format = crate::cmd_retarget::parse_format(Some(format))?
             .context("an output format is required")?;
         let markers = config_path
@@ -173,7 +179,9 @@ impl Job {
             .transpose()?;
         Ok(Job {
             model: crate::shipped::robot_model(robot)?,
-            config,
+            robot: crate::cmd_retarget::robot_label(robot),
+            given,
+            tuned,
             markers,
             config_path: config_path.map(Path::to_path_buf),
             options: RetargetOptions { human_height, ..RetargetOptions::default() },
@@ -187,15 +195,30 @@ impl Job {
     fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<ClipResult> {
         remove_stale_temporaries(dst);
         let is_c3d = src.extension().is_some_and(|e| e.eq_ignore_ascii_case("c3d"));
-        let (motion, diag) = if is_c3d {
+        let (motion, diag, config) = if is_c3d {
             self.convert_c3d(src)?
         } else {
             let bvh = bvh::from_path(src)?;
-            retarget::retarget_bvh(&bvh, &self.model, &self.config, &self.options)
-                .with_context(|| format!("{}: retargeting", src.display()))?
+            let gmr = self.options.mode == retarget::SolveMode::Gmr;
+            let chosen = retarget::derive::choose(
+                &self.model,
+                &self.robot,
+                &bvh,
+                &self.options.fk,
+                self.given.clone(),
+                self.tuned.as_ref(),
+                gmr,
+            )
+            .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+            let (motion, mut diag) =
+                retarget::retarget_bvh(&bvh, &self.model, &chosen.config, &self.options)
+                    .with_context(|| format!("{}: retargeting", src.display()))?;
+            diag.human_inferred =
+                crate::cmd_retarget::with_config(&diag.human_inferred, &chosen.summary);
+            (motion, diag, chosen.config)
         };
         let report_options = retarget::report::ReportOptions {
-            position_targets: Some(self.config.position_targets()),
+            position_targets: Some(config.position_targets()),
             ..retarget::report::ReportOptions::default()
         };
         let quality = retarget::report::report(&motion, &self.model, &report_options)?;
@@ -219,7 +242,7 @@ impl Job {
     fn convert_c3d(
         &self,
         src: &Path,
-    ) -> anyhow::Result<(retarget::RobotMotion, retarget::ClipDiagnostics)> {
+    ) -> anyhow::Result<(retarget::RobotMotion, retarget::ClipDiagnostics, IkConfig)> {
         let Some(markers) = &self.markers else {
             bail!(
                 "{}: a C3D clip needs a marker config: --config with `marker_bodies` (e.g. configs/c3d_plugingait_to_unitree_g1.json){}",
@@ -232,11 +255,14 @@ impl Job {
         let (human, height, source) =
             crate::cmd_retarget::c3d_human_motion(src, markers, self.options.human_height)?;
         let options = RetargetOptions { human_height: Some(height), ..self.options.clone() };
+        let Some(config) = self.given.clone() else {
+            bail!("{}: a C3D clip needs --config (a marker config)", src.display());
+        };
         let (motion, mut diag) =
-            crate::cmd_retarget::retarget_human(&human, &self.model, &self.config, &options)
+            crate::cmd_retarget::retarget_human(&human, &self.model, &config, &options)
                 .with_context(|| format!("{}: retargeting", src.display()))?;
         diag.human_height_source = source;
-        Ok((motion, diag))
+        Ok((motion, diag, config))
     }
 }
 

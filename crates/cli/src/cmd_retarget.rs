@@ -30,8 +30,9 @@ pub struct MainArgs {
     /// `<input stem>.npz` next to the input.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// IK config (GMR schema). Default: the shipped LAFAN1 config of a shipped robot;
-    /// required with a model path as --robot.
+    /// IK config (GMR schema), used as given; a role-named config (`retarget robot init`) is
+    /// bound to the skeleton. Default: GMR's tuned config for a shipped robot and a
+    /// LAFAN1-named skeleton, else a config derived from the robot's and the skeleton's roles.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Subject height in metres (default: estimated from the skeleton; GMR assumes 1.75).
@@ -88,7 +89,6 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     };
     let format = parse_format(args.format.as_deref())?;
     let output = output_path(&input, args.output.as_deref(), format);
-    let config = resolve_config(&robot, args.config.as_deref())?;
     let model = shipped::robot_model(&robot)?;
     let started = Instant::now();
     let mode = if args.gmr { SolveMode::Gmr } else { SolveMode::default() };
@@ -102,6 +102,7 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         ..RetargetOptions::default()
     };
     let (motion, diag) = if args.c3d.is_some() {
+        let config = resolve_config(&robot, args.config.as_deref())?;
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
         let markers = MarkerConfig::from_file(config_path)?;
         let (human, height, source) = c3d_human_motion(&input, &markers, args.human_height)?;
@@ -113,8 +114,13 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     } else {
         let bvh =
             crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
-        retarget::retarget_bvh(&bvh, &model, &config, &options)
-            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
+        let chosen =
+            choose_config(&robot, &model, args.config.as_deref(), args.gmr, &bvh, &options.fk)
+                .with_context(|| format!("{}: choosing the IK config", input.display()))?;
+        let (motion, mut diag) = retarget::retarget_bvh(&bvh, &model, &chosen.config, &options)
+            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?;
+        diag.human_inferred = with_config(&diag.human_inferred, &chosen.summary);
+        (motion, diag)
     };
     match args.fps {
         Some(fps) => {
@@ -277,6 +283,43 @@ pub(crate) fn c3d_human_motion(
         bail!("{}: subject height {height} m is not positive", path.display());
     }
     Ok((human, height, source))
+}
+
+/// The IK config for retargeting `bvh` onto `model` ([`retarget::derive::choose`]): the
+/// `--config` file (bound to the skeleton when role-named), GMR's tuned config of a shipped
+/// robot (always with `--gmr`; else when the skeleton has its names and joint frames), or the
+/// config derived from the robot's and the skeleton's roles.
+pub fn choose_config(
+    robot: &str,
+    model: &mjcf::Model,
+    config: Option<&Path>,
+    gmr: bool,
+    bvh: &bvh::Bvh,
+    fk: &fk::FkOptions,
+) -> anyhow::Result<retarget::derive::Chosen> {
+    let given = config.map(IkConfig::from_file).transpose()?;
+    let tuned = shipped_config(robot).transpose()?;
+    let name = robot_label(robot);
+    Ok(retarget::derive::choose(model, &name, bvh, fk, given, tuned.as_ref(), gmr)?)
+}
+
+/// A robot argument as messages name it: the shipped key, or the model file's stem.
+pub fn robot_label(robot: &str) -> String {
+    match Path::new(robot).file_stem() {
+        Some(stem) if robot.contains('.') || robot.contains(std::path::MAIN_SEPARATOR) => {
+            stem.to_string_lossy().into_owned()
+        }
+        _ => robot.to_owned(),
+    }
+}
+
+/// The one-line summary of what was inferred, with the config that was used.
+pub fn with_config(inferred: &str, config: &str) -> String {
+    if inferred.is_empty() {
+        config.to_owned()
+    } else {
+        format!("{inferred}; {config}")
+    }
 }
 
 /// The IK config at `path`, else the shipped default of robot `robot`.

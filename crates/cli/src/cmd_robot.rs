@@ -11,10 +11,24 @@ use crate::shipped;
 
 #[derive(Subcommand, Debug)]
 pub enum RobotCommand {
-    /// Print joints, ranges and bodies of a robot (shipped name, MJCF or URDF path).
+    /// Print joints, ranges and bodies of a robot (shipped name, MJCF or URDF path), and
+    /// which body plays each role of the canonical humanoid (and the rule that decided it).
     Info {
         /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
         robot: String,
+    },
+    /// Write the IK config derived for a robot (GMR schema): against the canonical human,
+    /// with role names as human joints (bound to each skeleton when used with --config), or
+    /// against the skeleton of --bvh, with its joint names.
+    Init {
+        /// Shipped name, MJCF (.xml) or URDF (.urdf) path.
+        robot: String,
+        /// Derive against this BVH's skeleton instead of the canonical human.
+        #[arg(long, value_name = "FILE")]
+        bvh: Option<std::path::PathBuf>,
+        /// Output JSON file.
+        #[arg(short, long, value_name = "FILE")]
+        output: std::path::PathBuf,
     },
     /// Compare our kinematics with MuJoCo's at random configurations (needs the `mujoco`
     /// feature): model structure, body poses and body Jacobians.
@@ -60,6 +74,7 @@ pub fn list() -> anyhow::Result<ExitCode> {
 pub fn run(cmd: RobotCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         RobotCommand::Info { robot } => info(&robot),
+        RobotCommand::Init { robot, bvh, output } => init(&robot, bvh.as_deref(), &output),
         RobotCommand::Check { robot, configs, seed, tolerance } => {
             check(&robot, configs, seed, tolerance)
         }
@@ -112,7 +127,43 @@ fn info(robot: &str) -> anyhow::Result<ExitCode> {
         let parent = if i == 0 { "-" } else { &model.bodies[b.parent].name };
         writeln!(out, "  {i:>3} {:<32} {parent}", b.name)?;
     }
+    writeln!(out, "\nroles (the canonical humanoid's, at qpos0):")?;
+    match retarget::RobotRoles::recognise(&model) {
+        Ok(roles) => out.push_str(&roles.describe(&model)),
+        Err(e) => writeln!(out, "  not recognised: {e}")?,
+    }
     emit(&out)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `retarget robot init ROBOT [--bvh FILE] -o OUT.json`.
+fn init(
+    robot: &str,
+    bvh: Option<&std::path::Path>,
+    output: &std::path::Path,
+) -> anyhow::Result<ExitCode> {
+    use anyhow::Context;
+    use retarget::derive::{derive, human_body, HumanBody};
+    let model = shipped::robot_model(robot)?;
+    let roles = retarget::RobotRoles::recognise(&model)?;
+    let label = crate::cmd_retarget::robot_label(robot);
+    let (human, against) = match bvh {
+        Some(path) => {
+            let file =
+                crate::cmd_bvh::read_bvh(path).with_context(|| path.display().to_string())?;
+            let human = human_body(&file, &fk::FkOptions::default(), &path.display().to_string())
+                .with_context(|| format!("{}: the skeleton", path.display()))?;
+            (human, path.display().to_string())
+        }
+        None => (HumanBody::canonical(), "the canonical human (role names)".to_owned()),
+    };
+    let config = derive(&model, &roles, &human, &output.display().to_string())?;
+    crate::atomic_write(output, config.json().as_bytes())?;
+    println!(
+        "wrote {}: {} tracked bodies of {label} against {against}",
+        output.display(),
+        config.ik_match_table1.len()
+    );
     Ok(ExitCode::SUCCESS)
 }
 

@@ -86,16 +86,27 @@ fn output_format_from_extension_and_height_option() {
 }
 
 #[test]
-fn mjcf_path_needs_a_config() {
+fn mjcf_path_without_config_derives_one_and_init_writes_it() {
     let dir = temp_dir("path");
     let Some(bvh) = short_walk(&dir, 5) else { return };
     let xml = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/unitree_g1/unitree_g1.xml");
     let out = retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", xml.to_str().unwrap()]);
-    let (_, stderr) = text(&out);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(stderr.contains("--config"), "{stderr}");
-    let config =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("config derived from the roles of unitree_g1"), "{stdout}");
+    // The shipped robot keeps GMR's tuned config on a LAFAN1 skeleton.
+    let out = retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", "unitree_g1"]);
+    let (stdout, _) = text(&out);
+    assert!(stdout.contains("bvh_lafan1_to_unitree_g1.json (tuned"), "{stdout}");
+    // `robot init` writes a role-named config; --config binds it to the skeleton.
+    let config = dir.join("g1.json");
+    let out = retarget(&["robot", "init", xml.to_str().unwrap(), "-o", config.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let written = std::fs::read_to_string(&config).unwrap();
+    assert!(
+        written.contains("\"left_thigh\": [") || written.contains("[\"left_thigh\","),
+        "{written}"
+    );
     let out = retarget(&[
         "--bvh",
         bvh.to_str().unwrap(),
@@ -106,7 +117,38 @@ fn mjcf_path_needs_a_config() {
         "-o",
         dir.join("o.npz").to_str().unwrap(),
     ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("(role-named), bound to the skeleton"), "{stdout}");
+    // Against a skeleton: its joint names.
+    let out = retarget(&[
+        "robot",
+        "init",
+        "booster_t1_29dof",
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "-o",
+        config.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", text(&out).1);
+    assert!(std::fs::read_to_string(&config).unwrap().contains("\"LeftUpLeg\""));
+}
+
+#[test]
+fn robot_info_prints_the_roles_and_refuses_a_wheeled_robot() {
+    let out = retarget(&["robot", "info", "unitree_g1"]);
+    let (stdout, _) = text(&out);
+    assert!(out.status.success());
+    assert!(stdout.contains("left_thigh       left_hip_yaw_link"), "{stdout}");
+    assert!(stdout.contains("left  sole       left_ankle_roll_link"), "{stdout}");
+    let wheeled =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../retarget/tests/data/robots/wheeled.xml");
+    let out = retarget(&["robot", "info", wheeled.to_str().unwrap()]);
+    let (stdout, _) = text(&out);
+    assert!(
+        stdout.contains("not recognised: robot `small` is not a two-armed biped: wheeled"),
+        "{stdout}"
+    );
 }
 
 #[test]

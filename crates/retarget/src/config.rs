@@ -160,6 +160,13 @@ impl IkConfig {
         Ok(config)
     }
 
+    /// The JSON text the config was read from (for a derived config: the text it was
+    /// written as, which `retarget robot init` saves).
+    #[must_use]
+    pub fn json(&self) -> &str {
+        &self.text
+    }
+
     /// The tables the solver runs, in order (table 1 then table 2, each if enabled).
     #[must_use]
     pub fn stages(&self) -> Vec<&[MatchEntry]> {

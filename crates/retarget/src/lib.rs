@@ -5,6 +5,7 @@ pub mod chunked;
 pub mod config;
 pub mod constraints;
 pub mod contact;
+pub mod derive;
 pub mod feet;
 pub mod lie;
 pub mod motion;
@@ -12,6 +13,8 @@ pub mod pipeline;
 pub mod qp;
 pub mod report;
 pub mod resample;
+pub mod robot_names;
+pub mod robot_roles;
 pub mod solver;
 pub mod targets;
 pub mod writers;
@@ -22,4 +25,5 @@ pub use pipeline::{
     retarget_bvh, retarget_motion, ClipDiagnostics, Error, PlausibleOptions, RetargetOptions,
     SolveMode, SpeedLimits,
 };
+pub use robot_roles::{RobotRole, RobotRoles, Sole};
 pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};

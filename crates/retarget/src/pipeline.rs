@@ -37,6 +37,10 @@ pub enum Error {
     /// Human forward kinematics failed (bad BVH content, NaN in the motion, ...).
     #[error(transparent)]
     Fk(#[from] fk::Error),
+    /// A robot model in which no two-armed biped standing at `qpos0` is found
+    /// ([`crate::robot_roles`]).
+    #[error("robot `{model}` is not a two-armed biped: {reason}")]
+    NotHumanoid { model: String, reason: String },
     /// Non-finite target or solver state at a frame.
     #[error("frame {frame}: {message}")]
     NonFinite { frame: usize, message: String },
