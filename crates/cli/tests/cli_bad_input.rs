@@ -73,11 +73,10 @@ fn a_clip_without_frames_is_an_error_and_writes_nothing() {
         let out = retarget(&args.concat());
         let (stdout, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(1), "{extra:?}: {stdout}{stderr}");
-        let expected = format!(
-            "error: {}: retargeting onto unitree_g1: the motion has no frames",
-            bvh.display()
-        );
-        assert_eq!(stderr.trim(), expected);
+        // The file, then the step that found it (config choice or retargeting), then why.
+        let (text, path) = (stderr.trim(), format!("error: {}: ", bvh.display()));
+        assert!(text.starts_with(&path) && text.ends_with(": the motion has no frames"), "{text}");
+        assert_eq!(text.lines().count(), 1, "{text}");
         assert!(stdout.is_empty(), "{stdout}");
         assert_eq!(listing(&dir), ["zero.bvh"]);
     }
@@ -119,7 +118,10 @@ fn a_batch_reports_a_clip_without_frames_and_goes_on() {
     let failed = rows.iter().find(|r| r["input"] == "a/zero.bvh").unwrap();
     assert_eq!(failed["status"], "failed");
     let error = failed["error"].as_str().unwrap();
-    assert!(error.ends_with("zero.bvh: retargeting: the motion has no frames"), "{error}");
+    assert!(
+        error.contains("zero.bvh: ") && error.ends_with(": the motion has no frames"),
+        "{error}"
+    );
     assert_eq!(rows.iter().find(|r| r["input"] == "b.bvh").unwrap()["frames"], 25);
     assert_eq!(listing(&out_dir), ["b.npz", "summary.json"]);
 }
@@ -143,10 +145,8 @@ fn an_absurd_coordinate_is_an_error_naming_the_frame() {
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
     assert!(
-        stderr.starts_with(&format!(
-            "error: {}: retargeting onto unitree_g1: frame 7: body `Hips` is 1.000e298 m",
-            bvh.display()
-        )),
+        stderr.starts_with(&format!("error: {}: ", bvh.display()))
+            && stderr.contains(": frame 7: body `Hips` is 1.000e298 m from the origin"),
         "{stderr}"
     );
     assert_eq!(listing(&dir), ["huge.bvh"]);

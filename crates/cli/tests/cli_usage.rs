@@ -82,14 +82,15 @@ fn help_entries(help: &str) -> BTreeMap<String, String> {
     for line in help.lines() {
         let trimmed = line.trim_start();
         let indent = line.len() - trimmed.len();
-        if indent == 2
-            && (trimmed.starts_with('-') || trimmed.starts_with('<') || trimmed.starts_with('['))
-        {
+        let starts_entry =
+            trimmed.starts_with('-') || trimmed.starts_with('<') || trimmed.starts_with('[');
+        // Clap indents `-o, --output` and arguments by 2, `--bvh` (no short flag) by 6.
+        if (2..=6).contains(&indent) && starts_entry {
             let (name, rest) = trimmed.split_once("  ").unwrap_or((trimmed, ""));
             let key = name.trim().to_owned();
             out.insert(key.clone(), rest.trim().to_owned());
             last = Some(key);
-        } else if indent > 2 && !trimmed.is_empty() {
+        } else if indent > 6 && !trimmed.is_empty() {
             if let Some(key) = &last {
                 let entry = out.entry(key.clone()).or_default();
                 entry.push(' ');
