@@ -97,17 +97,26 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
 }
 
 /// [`read_npz`] on any reader; `path` names it in errors.
-fn read_npz_from<R: Read + Seek>(reader: R, path: &Path) -> Result<BTreeMap<String, Array>, Error> {
+fn read_npz_from<R: Read + Seek>(
+    mut reader: R,
+    path: &Path,
+) -> Result<BTreeMap<String, Array>, Error> {
     let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
+    let io_error = |source| Error::Io { path: path.to_path_buf(), source };
+    // The archive's real length: the only size in it that the file cannot lie about.
+    let file_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io_error)?;
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(io_error)?;
     let mut zip =
         zip::ZipArchive::new(reader).map_err(|e| read_error(format!("not an .npz: {e}")))?;
     let mut arrays = BTreeMap::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
         let Some(key) = member.name().strip_suffix(".npy").map(str::to_owned) else { continue };
-        // The declared size is the file's word: believe it only as far as the compressed
-        // bytes can hold (deflate expands at most 1032:1), and never read past it.
-        let (size, packed) = (member.size(), member.compressed_size());
+        // Sizes in the headers are the file's word: the compressed size cannot exceed the
+        // archive, the declared size cannot exceed what those bytes inflate to (deflate
+        // expands at most 1032:1), reading stops at the declared size, and the buffer starts
+        // no larger than the archive (it grows only with bytes really inflated).
+        let (size, packed) = (member.size(), member.compressed_size().min(file_len));
         let bound = match member.compression() {
             zip::CompressionMethod::Stored => packed,
             _ => packed.saturating_mul(MAX_DEFLATE_RATIO).saturating_add(1024),
@@ -117,7 +126,7 @@ fn read_npz_from<R: Read + Seek>(reader: R, path: &Path) -> Result<BTreeMap<Stri
                 "{key}: member claims {size} bytes from {packed} stored bytes"
             )));
         }
-        let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
+        let mut bytes = Vec::with_capacity(usize::try_from(size.min(file_len)).unwrap_or(0));
         member
             .by_ref()
             .take(size)
