@@ -111,20 +111,19 @@ impl HumanMotion {
         let body = |k: usize| self.body_names.get(k).cloned().unwrap_or_default();
         let frames =
             self.positions.chunks_exact(nb.max(1)).zip(self.orientations.chunks_exact(nb.max(1)));
+        // Squared norms on the common path (a finite square within the bound implies finite
+        // coordinates); the exact figures are computed only for the error message.
+        let (max_d2, max_s2) = (MAX_DISTANCE * MAX_DISTANCE, MAX_STEP * MAX_STEP);
         let mut previous: Option<&[Vector3<f64>]> = None;
         for (frame, (positions, orientations)) in frames.enumerate() {
             for (k, (p, q)) in positions.iter().zip(orientations).enumerate() {
-                if !(p.iter().all(|v| v.is_finite()) && q.coords.iter().all(|v| v.is_finite())) {
-                    return Err(Error::NonFinitePose { frame, body: body(k) });
-                }
-                let distance = robust_norm(p);
-                if distance > MAX_DISTANCE {
-                    return Err(Error::AbsurdPosition { frame, body: body(k), distance });
-                }
-                let step =
-                    previous.and_then(|before| before.get(k)).map_or(0.0, |b| (p - b).norm());
-                if step > MAX_STEP {
-                    return Err(Error::AbsurdStep { frame, body: body(k), step });
+                let before = previous.and_then(|before| before.get(k));
+                let step2 = before.map_or(0.0, |b| (p - b).norm_squared());
+                let fine = p.norm_squared() <= max_d2
+                    && step2 <= max_s2
+                    && q.coords.norm_squared().is_finite();
+                if !fine {
+                    return Err(pose_error(frame, body(k), p, q, before));
                 }
             }
             previous = Some(positions);
@@ -137,6 +136,25 @@ impl HumanMotion {
         assert!(frame < self.num_frames && body < n, "frame {frame} body {body} out of range");
         frame * n + body
     }
+}
+
+/// Why a pose failed [`HumanMotion::validate`]'s quick test.
+fn pose_error(
+    frame: usize,
+    body: String,
+    p: &Vector3<f64>,
+    q: &UnitQuaternion<f64>,
+    before: Option<&Vector3<f64>>,
+) -> Error {
+    if !(p.iter().all(|v| v.is_finite()) && q.coords.iter().all(|v| v.is_finite())) {
+        return Error::NonFinitePose { frame, body };
+    }
+    let distance = robust_norm(p);
+    if distance > MAX_DISTANCE {
+        return Error::AbsurdPosition { frame, body, distance };
+    }
+    let step = before.map_or(0.0, |b| robust_norm(&(p - b)));
+    Error::AbsurdStep { frame, body, step }
 }
 
 /// `‖p‖` without overflow for huge finite coordinates (1e300² is infinite).
