@@ -65,7 +65,7 @@ unsafe impl GlobalAlloc for GuardedAlloc {
     }
 }
 
-/// Where [`report`] saves the input of an oversized allocation (`<dir>/abort-<target>.bin`).
+/// Where an oversized allocation or an abort saves the input (`<dir>/abort-<target>.bin`).
 pub fn set_crash_dir(target: &str, dir: Option<&Path>) {
     if let Some(dir) = dir {
         let _ = std::fs::create_dir_all(dir);
