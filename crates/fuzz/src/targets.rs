@@ -116,42 +116,13 @@ fn name(u: &mut Unstructured<'_>, names: &[&str]) -> Result<String> {
 // ------------------------------------------------------------------------------------------
 // BVH
 
+#[rustfmt::skip]
 const JOINT_NAMES: &[&str] = &[
-    "Hips",
-    "Spine",
-    "Spine1",
-    "Spine2",
-    "Neck",
-    "Head",
-    "LeftShoulder",
-    "LeftArm",
-    "LeftForeArm",
-    "LeftHand",
-    "RightShoulder",
-    "RightArm",
-    "RightForeArm",
-    "RightHand",
-    "LeftUpLeg",
-    "LeftLeg",
-    "LeftFoot",
-    "LeftToe",
-    "LeftToeBase",
-    "RightUpLeg",
-    "RightLeg",
-    "RightFoot",
-    "RightToe",
-    "RightToeBase",
-    "pelvis",
-    "lThigh",
-    "Bip01 L Calf",
-    "thigh_l",
-    "LeftHip",
-    "LeftKnee",
-    "LeftAnkle",
-    "L_Hip",
-    "root",
-    "lfemur",
-    "ltibia",
+    "Hips", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftShoulder", "LeftArm",
+    "LeftForeArm", "LeftHand", "RightShoulder", "RightArm", "RightForeArm", "RightHand",
+    "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToe", "LeftToeBase", "RightUpLeg", "RightLeg",
+    "RightFoot", "RightToe", "RightToeBase", "pelvis", "lThigh", "Bip01 L Calf", "thigh_l",
+    "LeftHip", "LeftKnee", "LeftAnkle", "L_Hip", "root", "lfemur", "ltibia",
 ];
 
 #[derive(Debug, Arbitrary)]
@@ -265,30 +236,14 @@ impl Target for BvhTarget {
         Ok(out.into_bytes())
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &[
-            "{",
-            "}",
-            "\n",
-            "\r\n",
-            "\t",
-            " ",
-            "ROOT ",
-            "JOINT ",
-            "End Site",
-            "OFFSET ",
+            "{", "}", "\n", "\r\n", "\t", " ", "ROOT ", "JOINT ", "End Site", "OFFSET ",
             "CHANNELS ",
             "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
-            "CHANNELS 3 Zrotation Xrotation Yrotation",
-            "MOTION\n",
-            "Frames: ",
-            "Frame Time: ",
-            "HIERARCHY\n",
-            "Xposition",
-            "Yrotation",
-            "nan",
-            "1e300",
-            "\u{feff}",
+            "CHANNELS 3 Zrotation Xrotation Yrotation", "MOTION\n", "Frames: ", "Frame Time: ",
+            "HIERARCHY\n", "Xposition", "Yrotation", "nan", "1e300", "\u{feff}",
         ]
     }
 
@@ -370,6 +325,7 @@ impl C3dTarget {
     }
 }
 
+#[rustfmt::skip]
 const LABELS: &[&str] = &[
     "LASI", "RASI", "LPSI", "RPSI", "LTHI", "LKNE", "LTIB", "LANK", "LHEE", "LTOE", "RANK", "RHEE",
     "RTOE", "C7", "T10", "CLAV", "STRN", "LSHO", "LELB", "LWRA", "LFIN", "RFHD", "",
@@ -400,6 +356,7 @@ impl Target for C3dTarget {
         Ok(Self::make(&spec).unwrap_or_default())
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &["POINT", "ANALOG", "LABELS", "USED", "SCALE", "RATE", "FRAMES", "DATA_START", "EVENT"]
     }
@@ -574,70 +531,18 @@ fn exercise(model: &mjcf::Model) {
 
 struct MjcfTarget;
 
+#[rustfmt::skip]
 const MJCF_TAGS: &[&str] = &[
-    "mujoco",
-    "worldbody",
-    "body",
-    "joint",
-    "freejoint",
-    "geom",
-    "site",
-    "inertial",
-    "default",
-    "compiler",
-    "option",
-    "frame",
-    "asset",
-    "mesh",
-    "actuator",
-    "motor",
-    "contact",
-    "exclude",
-    "equality",
-    "sensor",
-    "keyframe",
-    "key",
-    "size",
-    "visual",
-    "camera",
-    "light",
+    "mujoco", "worldbody", "body", "joint", "freejoint", "geom", "site", "inertial", "default",
+    "compiler", "option", "frame", "asset", "mesh", "actuator", "motor", "contact", "exclude",
+    "equality", "sensor", "keyframe", "key", "size", "visual", "camera", "light",
 ];
+#[rustfmt::skip]
 const MJCF_ATTRS: &[&str] = &[
-    "name",
-    "pos",
-    "quat",
-    "axisangle",
-    "euler",
-    "xyaxes",
-    "zaxis",
-    "type",
-    "axis",
-    "range",
-    "limited",
-    "size",
-    "fromto",
-    "class",
-    "childclass",
-    "angle",
-    "eulerseq",
-    "autolimits",
-    "mass",
-    "diaginertia",
-    "fullinertia",
-    "ref",
-    "springref",
-    "armature",
-    "damping",
-    "joint",
-    "body1",
-    "body2",
-    "qpos",
-    "model",
-    "file",
-    "meshdir",
-    "contype",
-    "conaffinity",
-    "group",
+    "name", "pos", "quat", "axisangle", "euler", "xyaxes", "zaxis", "type", "axis", "range",
+    "limited", "size", "fromto", "class", "childclass", "angle", "eulerseq", "autolimits",
+    "mass", "diaginertia", "fullinertia", "ref", "springref", "armature", "damping", "joint",
+    "body1", "body2", "qpos", "model", "file", "meshdir", "contype", "conaffinity", "group",
 ];
 
 impl Target for MjcfTarget {
@@ -665,21 +570,11 @@ impl Target for MjcfTarget {
         Ok(out.into_bytes())
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &[
-            "<body>",
-            "</body>",
-            "<joint/>",
-            "<geom size=\"1\"/>",
-            "name=\"",
-            "pos=\"",
-            "\"",
-            "<",
-            ">",
-            "/>",
-            "&amp;",
-            "<!--",
-            "-->",
+            "<body>", "</body>", "<joint/>", "<geom size=\"1\"/>", "name=\"", "pos=\"", "\"",
+            "<", ">", "/>", "&amp;", "<!--", "-->",
         ]
     }
 
@@ -696,54 +591,17 @@ impl Target for MjcfTarget {
 
 struct UrdfTarget;
 
+#[rustfmt::skip]
 const URDF_TAGS: &[&str] = &[
-    "robot",
-    "link",
-    "joint",
-    "parent",
-    "child",
-    "origin",
-    "axis",
-    "limit",
-    "inertial",
-    "mass",
-    "inertia",
-    "collision",
-    "visual",
-    "geometry",
-    "box",
-    "sphere",
-    "cylinder",
-    "mesh",
-    "mimic",
-    "dynamics",
-    "mujoco",
-    "compiler",
+    "robot", "link", "joint", "parent", "child", "origin", "axis", "limit", "inertial", "mass",
+    "inertia", "collision", "visual", "geometry", "box", "sphere", "cylinder", "mesh", "mimic",
+    "dynamics", "mujoco", "compiler",
 ];
+#[rustfmt::skip]
 const URDF_ATTRS: &[&str] = &[
-    "name",
-    "type",
-    "link",
-    "xyz",
-    "rpy",
-    "lower",
-    "upper",
-    "effort",
-    "velocity",
-    "size",
-    "radius",
-    "length",
-    "filename",
-    "value",
-    "ixx",
-    "iyy",
-    "izz",
-    "ixy",
-    "ixz",
-    "iyz",
-    "fusestatic",
-    "joint",
-    "multiplier",
+    "name", "type", "link", "xyz", "rpy", "lower", "upper", "effort", "velocity", "size",
+    "radius", "length", "filename", "value", "ixx", "iyy", "izz", "ixy", "ixz", "iyz",
+    "fusestatic", "joint", "multiplier",
 ];
 
 /// A URDF robot: links joined into a random tree by joints of every type, with origins,
@@ -847,17 +705,11 @@ impl Target for UrdfTarget {
         Ok(out.into_bytes())
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &[
-            "<link name=\"a\"/>",
-            "<joint name=\"j\" type=\"revolute\">",
-            "</joint>",
-            "<parent link=\"a\"/>",
-            "<child link=\"b\"/>",
-            "\"",
-            "<",
-            ">",
-            "/>",
+            "<link name=\"a\"/>", "<joint name=\"j\" type=\"revolute\">", "</joint>",
+            "<parent link=\"a\"/>", "<child link=\"b\"/>", "\"", "<", ">", "/>",
         ]
     }
 
@@ -872,46 +724,18 @@ impl Target for UrdfTarget {
 // ------------------------------------------------------------------------------------------
 // IK config (GMR JSON schema)
 
+#[rustfmt::skip]
 const LAFAN1_BODIES: &[&str] = &[
-    "Hips",
-    "LeftUpLeg",
-    "LeftLeg",
-    "LeftFoot",
-    "LeftToe",
-    "RightUpLeg",
-    "RightLeg",
-    "RightFoot",
-    "RightToe",
-    "Spine",
-    "Spine1",
-    "Spine2",
-    "Neck",
-    "Head",
-    "LeftShoulder",
-    "LeftArm",
-    "LeftForeArm",
-    "LeftHand",
-    "RightShoulder",
-    "RightArm",
-    "RightForeArm",
-    "RightHand",
-    "LeftFootMod",
-    "RightFootMod",
+    "Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToe", "RightUpLeg", "RightLeg", "RightFoot",
+    "RightToe", "Spine", "Spine1", "Spine2", "Neck", "Head", "LeftShoulder", "LeftArm",
+    "LeftForeArm", "LeftHand", "RightShoulder", "RightArm", "RightForeArm", "RightHand",
+    "LeftFootMod", "RightFootMod",
 ];
+#[rustfmt::skip]
 const G1_BODIES: &[&str] = &[
-    "pelvis",
-    "left_hip_yaw_link",
-    "left_knee_link",
-    "left_ankle_roll_link",
-    "torso_link",
-    "right_hip_yaw_link",
-    "right_knee_link",
-    "right_ankle_roll_link",
-    "left_elbow_link",
-    "left_shoulder_yaw_link",
-    "left_wrist_yaw_link",
-    "right_elbow_link",
-    "world",
+    "pelvis", "left_hip_yaw_link", "left_knee_link", "left_ankle_roll_link", "torso_link",
+    "right_hip_yaw_link", "right_knee_link", "right_ankle_roll_link", "left_elbow_link",
+    "left_shoulder_yaw_link", "left_wrist_yaw_link", "right_elbow_link", "world",
 ];
 
 struct ConfigTarget;
@@ -1039,22 +863,11 @@ impl Target for ConfigTarget {
         Ok(serde_json::to_vec_pretty(&serde_json::Value::Object(map)).unwrap_or_default())
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &[
-            "{",
-            "}",
-            "[",
-            "]",
-            ",",
-            ":",
-            "\"",
-            "null",
-            "true",
-            "1e999",
-            "\"Hips\"",
-            "\"pelvis\"",
-            "\\u0000",
-            "\\ud800",
+            "{", "}", "[", "]", ",", ":", "\"", "null", "true", "1e999", "\"Hips\"",
+            "\"pelvis\"", "\\u0000", "\\ud800",
         ]
     }
 
@@ -1293,18 +1106,10 @@ impl NpzTarget {
     }
 }
 
+#[rustfmt::skip]
 const NPZ_KEYS: &[&str] = &[
-    "fps",
-    "qpos",
-    "joint_names",
-    "body_names",
-    "target_body_names",
-    "target_pos",
-    "target_quat",
-    "contact_left",
-    "contact_right",
-    "robot",
-    "joint_pos",
+    "fps", "qpos", "joint_names", "body_names", "target_body_names", "target_pos", "target_quat",
+    "contact_left", "contact_right", "robot", "joint_pos",
 ];
 
 impl Target for NpzTarget {
@@ -1330,17 +1135,11 @@ impl Target for NpzTarget {
         Ok(Self::zip(&members))
     }
 
+    #[rustfmt::skip]
     fn dictionary(&self) -> &'static [&'static str] {
         &[
-            "'descr'",
-            "'shape'",
-            "<U0",
-            "<f8",
-            "(1,)",
-            "(100000000000000,)",
-            "PK\x03\x04",
-            "PK\x01\x02",
-            "PK\x05\x06",
+            "'descr'", "'shape'", "<U0", "<f8", "(1,)", "(100000000000000,)", "PK\x03\x04",
+            "PK\x01\x02", "PK\x05\x06",
         ]
     }
 
