@@ -4,38 +4,63 @@
 use std::path::Path;
 
 use anyhow::Context;
+use retarget::joint_speed::JointSpeedLimits;
 
-/// `(key, MJCF text)` of every shipped robot, sorted by key.
-pub const SHIPPED: &[(&str, &str)] = &[
-    ("booster_t1_29dof", include_str!("../../../robots/booster_t1_29dof/booster_t1_29dof.xml")),
-    ("engineai_pm01", include_str!("../../../robots/engineai_pm01/engineai_pm01.xml")),
-    ("fourier_n1", include_str!("../../../robots/fourier_n1/fourier_n1.xml")),
-    ("stanford_toddy", include_str!("../../../robots/stanford_toddy/stanford_toddy.xml")),
-    ("unitree_g1", include_str!("../../../robots/unitree_g1/unitree_g1.xml")),
-    ("unitree_h1", include_str!("../../../robots/unitree_h1/unitree_h1.xml")),
+/// `robots/<key>/<key>.xml` and `robots/<key>/joint_speed_limits.json`, compiled in.
+macro_rules! shipped {
+    ($key:literal) => {
+        (
+            $key,
+            include_str!(concat!("../../../robots/", $key, "/", $key, ".xml")),
+            include_str!(concat!("../../../robots/", $key, "/joint_speed_limits.json")),
+        )
+    };
+}
+
+/// `(key, MJCF text, joint speed limits)` of every shipped robot, sorted by key.
+pub const SHIPPED: &[(&str, &str, &str)] = &[
+    shipped!("booster_t1_29dof"),
+    shipped!("engineai_pm01"),
+    shipped!("fourier_n1"),
+    shipped!("stanford_toddy"),
+    shipped!("unitree_g1"),
+    shipped!("unitree_h1"),
 ];
 
 /// The MJCF text of a shipped robot.
+#[cfg(feature = "mujoco")]
 pub fn shipped_xml(key: &str) -> Option<&'static str> {
-    SHIPPED.iter().find(|(k, _)| *k == key).map(|(_, xml)| *xml)
+    SHIPPED.iter().find(|(k, _, _)| *k == key).map(|(_, xml, _)| *xml)
 }
 
 /// The keys of all shipped robots.
 pub fn shipped_keys() -> impl Iterator<Item = &'static str> {
-    SHIPPED.iter().map(|(k, _)| *k)
+    SHIPPED.iter().map(|(k, _, _)| *k)
 }
 
 /// A shipped robot by key, else the model file at that path (`.xml` MJCF or `.urdf` URDF, by
 /// [`mjcf::Model::from_path`]). An unknown name that is not a file errors with the list of
-/// shipped keys.
+/// shipped keys. Joint speed limits come from the robot's `joint_speed_limits.json`
+/// ([`retarget::joint_speed`]): the shipped one, or one beside a model file when present
+/// (a URDF's own `velocity` limits are kept unless the file lists the joint).
 pub fn robot_model(name_or_path: &str) -> anyhow::Result<mjcf::Model> {
-    if let Some(xml) = shipped_xml(name_or_path) {
-        return mjcf::Model::from_xml_str(xml, None).with_context(|| {
-            format!("shipped robot {name_or_path} (robots/{name_or_path}/{name_or_path}.xml)")
-        });
+    if let Some((key, xml, speeds)) = SHIPPED.iter().find(|(k, _, _)| *k == name_or_path) {
+        let mut model = mjcf::Model::from_xml_str(xml, None)
+            .with_context(|| format!("shipped robot {key} (robots/{key}/{key}.xml)"))?;
+        let origin = format!("robots/{key}/joint_speed_limits.json");
+        JointSpeedLimits::from_json_str(speeds, &origin)?.apply(&mut model, &origin)?;
+        return Ok(model);
     }
     if looks_like_path(name_or_path) {
-        return Ok(mjcf::Model::from_path(Path::new(name_or_path))?);
+        let path = Path::new(name_or_path);
+        let mut model = mjcf::Model::from_path(path)?;
+        let speeds = path.with_file_name("joint_speed_limits.json");
+        if speeds.is_file() {
+            let origin = speeds.display().to_string();
+            let text = std::fs::read_to_string(&speeds).with_context(|| origin.clone())?;
+            JointSpeedLimits::from_json_str(&text, &origin)?.apply(&mut model, &origin)?;
+        }
+        return Ok(model);
     }
     Err(unknown_robot(name_or_path))
 }
@@ -72,6 +97,8 @@ mod tests {
         for key in shipped_keys() {
             let model = robot_model(key).unwrap_or_else(|e| panic!("{key}: {e:#}"));
             assert!(model.nq > 7, "{key}");
+            let limited = model.joints.iter().filter(|j| j.velocity_limit.is_some()).count();
+            assert_eq!(limited, model.joints.len() - 1, "{key}: every joint but the root");
         }
     }
 

@@ -167,6 +167,62 @@ impl Model {
     }
 }
 
+/// Which robot geom pairs a retargeted motion must keep apart, and why the others are left
+/// out ([`Model::self_collision_pairs`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SelfCollisionPairs {
+    /// Pairs to keep apart (geom ids, `g1 < g2`).
+    pub pairs: Vec<[usize; 2]>,
+    /// MuJoCo would check these, but the bodies are joined through bodies without collision
+    /// geoms (a multi-axis joint built from a chain of small bodies): adjacent in effect.
+    pub adjacent: Vec<[usize; 2]>,
+    /// Already touching or overlapping at `qpos0`: the model's primitives overlap by design.
+    pub touching_at_rest: Vec<[usize; 2]>,
+}
+
+impl Model {
+    /// The robot's self-collision pairs for retargeting: MuJoCo's [`Model::collision_pairs`]
+    /// between primitives of two robot bodies (world geoms, planes and meshes left out), less
+    ///
+    /// - pairs whose bodies are adjacent in effect: one body is the nearest ancestor of the
+    ///   other that carries collision geoms (MuJoCo's parent filter extended over bodies
+    ///   without geoms, which MuJoCo leaves to `<exclude>` elements), and
+    /// - pairs already touching at `qpos0` (signed distance ≤ 0).
+    #[must_use]
+    pub fn self_collision_pairs(&self) -> SelfCollisionPairs {
+        let colliding = |g: &Geom| g.kind.is_primitive() && (g.contype != 0 || g.conaffinity != 0);
+        let has_geoms: Vec<bool> = (0..self.bodies.len())
+            .map(|b| self.geoms.iter().any(|g| g.body == b && colliding(g)))
+            .collect();
+        // Nearest ancestor (not the body itself) that carries collision geoms.
+        let geom_parent = |mut b: usize| -> usize {
+            loop {
+                b = self.bodies.get(b).map_or(0, |body| body.parent);
+                if b == 0 || has_geoms.get(b).copied().unwrap_or(false) {
+                    return b;
+                }
+            }
+        };
+        let mut data = Data::new(self);
+        self.kinematics(&self.qpos0, &mut data);
+        let mut out = SelfCollisionPairs::default();
+        for [g1, g2] in self.collision_pairs() {
+            let (a, b) = (&self.geoms[g1], &self.geoms[g2]);
+            if a.body == 0 || b.body == 0 || !colliding(a) || !colliding(b) {
+                continue;
+            }
+            if geom_parent(a.body) == b.body || geom_parent(b.body) == a.body {
+                out.adjacent.push([g1, g2]);
+            } else if geom_distance(self, &data, g1, g2, 0.0).is_some_and(|p| p.distance <= 0.0) {
+                out.touching_at_rest.push([g1, g2]);
+            } else {
+                out.pairs.push([g1, g2]);
+            }
+        }
+        out
+    }
+}
+
 /// A primitive's convex core (the radius is kept apart), in the geom's frame.
 #[derive(Debug, Clone, Copy)]
 enum Core {
@@ -447,6 +503,35 @@ mod tests {
 
     fn model(xml: &str) -> Model {
         Model::from_xml_str(xml, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// `waist` has no geoms: `torso` counts as adjacent to `pelvis`; `hand` touches `torso`
+    /// at rest; `foot` may collide with `torso` and `hand`.
+    #[test]
+    fn self_collision_pairs_leave_out_adjacent_and_resting_contacts() {
+        let m = model(
+            r#"<mujoco><worldbody><geom name="floor" type="plane" size="5 5 0.1"/>
+            <body name="pelvis" pos="0 0 1"><freejoint/><geom name="pelvis" size="0.1"/>
+              <body name="waist"><joint type="hinge" axis="0 0 1"/>
+                <body name="torso" pos="0 0 0.15"><joint type="hinge" axis="1 0 0"/>
+                  <geom name="torso" type="capsule" fromto="0 0 0 0 0 0.3" size="0.08"/>
+                </body>
+              </body>
+              <body name="hand" pos="0.1 0 0.25"><joint type="hinge"/><geom name="hand" size="0.05"/></body>
+              <body name="foot" pos="0 0 -0.6"><joint type="slide" axis="0 0 1"/><geom name="foot" type="box" size="0.1 0.05 0.02"/></body>
+            </body></worldbody></mujoco>"#,
+        );
+        let id = |n: &str| m.geom_id(n).unwrap();
+        let sorted = |a: &str, b: &str| {
+            let (x, y) = (id(a), id(b));
+            [x.min(y), x.max(y)]
+        };
+        let pairs = m.self_collision_pairs();
+        assert_eq!(pairs.adjacent, vec![sorted("pelvis", "torso")]);
+        assert_eq!(pairs.touching_at_rest, vec![sorted("torso", "hand")]);
+        let mut expect = vec![sorted("torso", "foot"), sorted("hand", "foot")];
+        expect.sort_unstable();
+        assert_eq!(pairs.pairs, expect, "the floor and parent-child pairs never appear");
     }
 
     fn at(model: &Model, qpos: &[f64]) -> Data {

@@ -43,7 +43,9 @@ mod urdf;
 
 use std::path::Path;
 
-pub use collision::{geom_bounding_sphere, geom_distance, geom_lowest_point, Proximity};
+pub use collision::{
+    geom_bounding_sphere, geom_distance, geom_lowest_point, Proximity, SelfCollisionPairs,
+};
 pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;

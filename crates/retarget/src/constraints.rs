@@ -31,8 +31,8 @@ pub trait Constraint: std::fmt::Debug + Send {
 }
 
 /// Nothing through the floor: the lowest point of every collision geom stays at or above
-/// `floor` (world z). Geoms whose lowest point is higher than `floor + activation` add no
-/// row (one step cannot bring them down that far).
+/// `floor` (world z). Points higher than `floor + activation` add no row (one step does not
+/// bring them down that far; the next step re-linearises).
 #[derive(Debug, Clone)]
 pub struct Ground {
     geoms: Vec<usize>,
@@ -52,7 +52,7 @@ impl Ground {
         Ground {
             geoms,
             floor,
-            activation: 0.15,
+            activation: 0.1,
             jacp: vec![0.0; 3 * model.nv],
             jacr: vec![0.0; 3 * model.nv],
         }
@@ -81,11 +81,10 @@ impl Constraint for Ground {
     }
 }
 
-/// The points of geom `g` that can become its lowest under a small rotation: a box's
-/// bottom corners (one linearised corner does not stop another from dipping when the box
+/// The points of geom `g` that can become its lowest under a small rotation: a box's four
+/// lowest corners (one linearised corner does not stop another from dipping when the box
 /// tilts), the lowest points of a capsule's two end spheres and of a cylinder's two rims,
-/// the support point of a sphere or ellipsoid. Corners and ends higher than the lowest by
-/// more than half the geom's size are left out.
+/// the support point of a sphere or ellipsoid.
 fn candidate_low_points(model: &Model, data: &Data, g: usize, out: &mut Vec<Vector3<f64>>) {
     out.clear();
     let geom = &model.geoms[g];
@@ -96,6 +95,8 @@ fn candidate_low_points(model: &Model, data: &Data, g: usize, out: &mut Vec<Vect
                 let sign = |bit: usize| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
                 out.push(c + r * Vector3::new(sign(0) * s[0], sign(1) * s[1], sign(2) * s[2]));
             }
+            out.sort_by(|a, b| a.z.total_cmp(&b.z));
+            out.truncate(4);
         }
         GeomType::Capsule | GeomType::Cylinder => {
             let axis = r.column(2).into_owned();
@@ -115,26 +116,83 @@ fn candidate_low_points(model: &Model, data: &Data, g: usize, out: &mut Vec<Vect
         }
         _ => out.push(lowest_point(model, data, g)),
     }
-    let low = out.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-    let reach = s.iter().copied().fold(0.0, f64::max);
-    out.retain(|p| p.z <= low + reach);
 }
 
-/// Geoms that collide (contype or conaffinity non-zero) and have a primitive shape.
+/// Geoms of the robot (not the world's) that collide (contype or conaffinity non-zero) and
+/// have a primitive shape.
 #[must_use]
 pub fn collision_primitives(model: &Model) -> Vec<usize> {
     (0..model.geoms.len())
         .filter(|&g| {
-            matches!(
-                model.geoms[g].kind,
-                GeomType::Sphere
-                    | GeomType::Capsule
-                    | GeomType::Ellipsoid
-                    | GeomType::Cylinder
-                    | GeomType::Box
-            )
+            let geom = &model.geoms[g];
+            geom.body != 0 && geom.kind.is_primitive() && (geom.contype | geom.conaffinity) != 0
         })
         .collect()
+}
+
+/// Nothing through itself: every pair of [`Model::self_collision_pairs`] closer than
+/// `activation` keeps its signed distance at or above `margin`, linearised at the witness
+/// points: `d + nᵀ (J₂(p₂) − J₁(p₁)) Δq ≥ margin` (`n` from geom 1 to geom 2).
+#[derive(Debug, Clone)]
+pub struct SelfCollision {
+    pairs: Vec<[usize; 2]>,
+    /// Bounding-sphere radius per geom (0 for geoms without one).
+    radius: Vec<f64>,
+    pub margin: f64,
+    pub activation: f64,
+    jac1: Vec<f64>,
+    jac2: Vec<f64>,
+    jacr: Vec<f64>,
+}
+
+impl SelfCollision {
+    #[must_use]
+    pub fn new(model: &Model) -> SelfCollision {
+        let nv = model.nv;
+        SelfCollision {
+            pairs: model.self_collision_pairs().pairs,
+            radius: model.geoms.iter().map(|g| g.bounding_radius().unwrap_or(0.0)).collect(),
+            margin: 0.0,
+            activation: 0.03,
+            jac1: vec![0.0; 3 * nv],
+            jac2: vec![0.0; 3 * nv],
+            jacr: vec![0.0; 3 * nv],
+        }
+    }
+
+    /// The pairs kept apart.
+    #[must_use]
+    pub fn pairs(&self) -> &[[usize; 2]] {
+        &self.pairs
+    }
+}
+
+impl Constraint for SelfCollision {
+    fn name(&self) -> &'static str {
+        "self-collision"
+    }
+
+    fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
+        let (model, data) = (ctx.model, ctx.data);
+        let nv = model.nv;
+        for &[g1, g2] in &self.pairs {
+            let reach = self.radius[g1] + self.radius[g2] + self.activation;
+            if (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared() > reach * reach {
+                continue;
+            }
+            let Some(p) = mjcf::geom_distance(model, data, g1, g2, self.activation) else {
+                continue;
+            };
+            model.jac(data, model.geoms[g1].body, &p.point1, &mut self.jac1, &mut self.jacr);
+            model.jac(data, model.geoms[g2].body, &p.point2, &mut self.jac2, &mut self.jacr);
+            let row = qp.add_row(self.margin - p.distance);
+            for (d, a) in row.iter_mut().enumerate() {
+                *a = (0..3)
+                    .map(|r| p.normal[r] * (self.jac2[r * nv + d] - self.jac1[r * nv + d]))
+                    .sum();
+            }
+        }
+    }
 }
 
 /// The world point of geom `g` with the smallest z (a support point in −z).

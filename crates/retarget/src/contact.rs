@@ -37,8 +37,8 @@ impl Default for ContactOptions {
         ContactOptions {
             height_on: 0.025,
             height_off: 0.045,
-            speed_on: 0.3,
-            speed_off: 0.6,
+            speed_on: 0.2,
+            speed_off: 0.35,
             min_phase_s: 0.1,
             floor_percentile: 0.02,
         }
@@ -199,7 +199,8 @@ mod tests {
             positions,
         };
         let foot = FootPoints { heel: 0, toe: None };
-        let c = detect(&human, [foot, foot], &ContactOptions::default()).left;
+        let options = ContactOptions { speed_off: 0.6, ..ContactOptions::default() };
+        let c = detect(&human, [foot, foot], &options).left;
         // Frame 9 moves at 0.5 m/s (central difference) but still holds: hysteresis.
         assert_eq!(phases(&c), vec![0..10, 20..30], "{c:?}");
     }

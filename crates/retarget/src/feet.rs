@@ -51,6 +51,9 @@ pub struct FootPlanOptions {
     pub stance_weight: f64,
     /// Height of the sole's lowest point above the floor while planted (m).
     pub clearance: f64,
+    /// Weight of the contact-point task that holds the sole's contact point on its anchor
+    /// in stance (the foot tasks' position weights are 50 in GMR's configs).
+    pub contact_weight: f64,
 }
 
 impl Default for FootPlanOptions {
@@ -61,6 +64,7 @@ impl Default for FootPlanOptions {
             lead_s: 1.0 / 30.0,
             stance_weight: 2.0,
             clearance: 0.002,
+            contact_weight: 400.0,
         }
     }
 }
@@ -75,13 +79,46 @@ pub struct RobotFoot {
     sole: Vec<(GeomType, [f64; 3], Isometry3<f64>)>,
     /// The foot body's forward direction in its own frame (world +x at `qpos0`).
     forward: Vector3<f64>,
+    /// The foot body's world orientation at `qpos0`: standing flat.
+    rest: UnitQuaternion<f64>,
+    /// The bottom corners of the sole's boxes, in the foot frame (lowest four at `qpos0`).
+    corners: Vec<Vector3<f64>>,
+    /// The shin: target slot of the nearest ancestor body with a task, and the foot's
+    /// orientation relative to it at `qpos0` (`shin⁻¹ ⊗ foot`).
+    shin: Option<(usize, UnitQuaternion<f64>)>,
+}
+
+/// Sole corners higher than the lowest point by this much (m) are not held vertically;
+/// lower ones are held the more, the lower they are.
+pub const CONTACT_PATCH: f64 = 0.01;
+
+/// A point of a planted sole: where it is in the foot (`point`, foot frame), where it stays
+/// (`at`, world), and the share of the contact weight that holds it horizontally and
+/// vertically. Every bottom corner of a box sole is held horizontally (so the foot neither
+/// slides nor turns, whatever tilt the robot's ankle can reach); vertically, the corners
+/// that touch the floor in the planted pose (four standing flat, two on the toes or the
+/// heel), fading out over [`CONTACT_PATCH`] above the lowest. A sole without boxes is held
+/// at its lowest point. The shares of one foot have a root sum of squares of 1 (per axis,
+/// standing flat), so a foot's hold does not depend on how many points it has.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolePoint {
+    pub point: Vector3<f64>,
+    pub at: Vector3<f64>,
+    pub horizontal: f64,
+    pub vertical: f64,
 }
 
 impl RobotFoot {
     /// `body` tracks target `slot`; its sole: the collision primitives of `sole_body` and its
     /// descendants (`None` when there are none).
     #[must_use]
-    pub fn new(model: &Model, body: usize, sole_body: usize, slot: usize) -> Option<RobotFoot> {
+    pub fn new(
+        model: &Model,
+        body: usize,
+        sole_body: usize,
+        slot: usize,
+        shin: Option<(usize, usize)>,
+    ) -> Option<RobotFoot> {
         let mut data = Data::new(model);
         model.kinematics(&model.qpos0, &mut data);
         let body_pose = pose_of(&data.xpos[body], &data.xmat[body]);
@@ -98,7 +135,28 @@ impl RobotFoot {
             return None;
         }
         let forward = data.xmat[body].transpose() * Vector3::x();
-        Some(RobotFoot { body, slot, sole, forward })
+        let corners = sole
+            .iter()
+            .filter(|(kind, _, _)| *kind == GeomType::Box)
+            .flat_map(|(_, s, rel)| {
+                let mut all: Vec<Vector3<f64>> = (0..8)
+                    .map(|k| {
+                        let sign = |bit: usize| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
+                        rel * nalgebra::Point3::new(sign(0) * s[0], sign(1) * s[1], sign(2) * s[2])
+                    })
+                    .map(|p| p.coords)
+                    .collect();
+                let rest = body_pose.rotation;
+                all.sort_by(|a, b| (rest * a).z.total_cmp(&(rest * b).z));
+                all.truncate(4);
+                all
+            })
+            .collect();
+        let shin = shin.map(|(shin_body, shin_slot)| {
+            let shin_rest = UnitQuaternion::from_matrix(&data.xmat[shin_body]);
+            (shin_slot, shin_rest.inverse() * body_pose.rotation)
+        });
+        Some(RobotFoot { body, slot, sole, forward, rest: body_pose.rotation, corners, shin })
     }
 
     /// Height of the sole's lowest point above the foot body's origin, for a body
@@ -112,6 +170,60 @@ impl RobotFoot {
                 (rot * rel.translation.vector).z + support_offset(*kind, size, &r).z
             })
             .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The sole's lowest point for a body orientation `rot`, in the foot body's frame.
+    #[must_use]
+    pub fn sole_low_point(&self, rot: &UnitQuaternion<f64>) -> Vector3<f64> {
+        let world = self
+            .sole
+            .iter()
+            .map(|(kind, size, rel)| {
+                let r = (rot * rel.rotation).to_rotation_matrix().into_inner();
+                rot * rel.translation.vector + support_offset(*kind, size, &r)
+            })
+            .min_by(|a, b| a.z.total_cmp(&b.z))
+            .unwrap_or_else(Vector3::zeros);
+        rot.inverse() * world
+    }
+
+    /// The orientation of the foot standing flat (as at `qpos0`) with yaw `yaw`.
+    fn flat(&self, yaw: f64) -> UnitQuaternion<f64> {
+        let turn = wrap(yaw - self.yaw(&self.rest));
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), turn) * self.rest
+    }
+
+    /// The sole points held at the planted `pose` ([`SolePoint`]), their weights scaled
+    /// by `scale` (fading in and out around a stance phase).
+    #[must_use]
+    pub fn contact_points(&self, pose: &Pose, scale: f64) -> Vec<SolePoint> {
+        let q = quat(pose);
+        let world = |p: &Vector3<f64>| pose.pos + q * p;
+        let low = self.sole_low_point(&q);
+        let floor = world(&low).z;
+        if self.corners.is_empty() {
+            let share = scale;
+            return vec![SolePoint {
+                point: low,
+                at: world(&low),
+                horizontal: share,
+                vertical: share,
+            }];
+        }
+        let share = scale / (self.corners.len() as f64).sqrt();
+        self.corners
+            .iter()
+            .map(|c| {
+                let at = world(c);
+                let lifted = ((at.z - floor) / CONTACT_PATCH).clamp(0.0, 1.0);
+                SolePoint {
+                    point: *c,
+                    at,
+                    horizontal: share,
+                    vertical: share * (1.0 - smoothstep(lifted)),
+                }
+            })
+            .collect()
     }
 
     /// Yaw (rad, about world z) of the foot's forward direction at orientation `rot`.
@@ -145,6 +257,9 @@ pub struct FootPlan {
     pub shift: f64,
     /// Per frame, `[left, right]` factors on the foot tasks' weights.
     pub weight: Vec<[f64; 2]>,
+    /// Per frame and foot in stance: points of the sole (foot frame), where they stay
+    /// (world), and which world axes hold them ([`SolePoint`]).
+    pub contact: Vec<[Vec<SolePoint>; 2]>,
 }
 
 /// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
@@ -165,19 +280,25 @@ pub fn plan(
     let blend = (options.blend_s * fps).round().max(0.0) as usize;
     let lead = (options.lead_s * fps).round().max(0.0) as usize;
     let mut weight = vec![[1.0; 2]; frames];
+    let mut contact = vec![[Vec::new(), Vec::new()]; frames];
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
         let label = &labels[side][..frames.min(labels[side].len())];
         let phase_list: Vec<Range<usize>> =
             phases(label).into_iter().map(|r| r.start.saturating_sub(lead)..r.end).collect();
         let free: Vec<Pose> = (0..frames).map(|t| targets[t * slots + foot.slot]).collect();
+        // The foot orientation each frame's shin target implies (the ankle straight).
+        let shin: Vec<Option<UnitQuaternion<f64>>> = (0..frames)
+            .map(|t| foot.shin.map(|(slot, rel)| quat(&targets[t * slots + slot]) * rel))
+            .collect();
         let mut ramp = vec![Ramp::default(); frames];
         let mut planted = vec![false; frames];
         for r in &phase_list {
-            let (xy, yaw) = anchor(foot, &free, r.clone(), options.anchor);
+            let (xy, yaw) = anchor(foot, &free, &shin, r.clone(), options.anchor);
             for t in r.clone() {
-                targets[t * slots + foot.slot] =
-                    planted_pose(foot, &free[t], xy, yaw, options.clearance);
+                let pose = planted_pose(foot, &free[t], xy, yaw, options.clearance);
+                contact[t][side] = foot.contact_points(&pose, 1.0);
+                targets[t * slots + foot.slot] = pose;
                 planted[t] = true;
             }
             // Offsets at touch-down and lift-off, faded in before and out after.
@@ -198,13 +319,15 @@ pub fn plan(
             if planted[t] {
                 weight[t][side] = options.stance_weight;
             } else if ramp[t].weight > 0.0 {
-                targets[t * slots + foot.slot] = ramp[t].apply(&free[t]);
+                let pose = ramp[t].apply(&free[t]);
                 let w = ramp[t].weight.min(1.0);
+                contact[t][side] = foot.contact_points(&pose, w);
+                targets[t * slots + foot.slot] = pose;
                 weight[t][side] = 1.0 + (options.stance_weight - 1.0) * w;
             }
         }
     }
-    FootPlan { shift, weight }
+    FootPlan { shift, weight, contact }
 }
 
 /// An offset of a foot target (position and yaw), accumulated with weights.
@@ -263,33 +386,49 @@ fn floor_shift(
     moves[moves.len() / 2]
 }
 
-/// Anchor of one phase: horizontal position and yaw, from the free targets.
+/// Anchor of one phase: the yaw (circular mean or first frame of the free targets' yaws),
+/// then the horizontal position of the flat foot that, rolled over its sole's lowest point
+/// to each free target's tilt, puts the foot origin where the free target is (its mean over
+/// the phase, or its first frame): a foot rolling from heel to toe without slipping has one
+/// such position.
 fn anchor(
     foot: &RobotFoot,
     free: &[Pose],
+    shin: &[Option<UnitQuaternion<f64>>],
     range: Range<usize>,
     kind: Anchor,
 ) -> (Vector3<f64>, f64) {
-    match kind {
-        Anchor::PhaseStart => {
-            let p = &free[range.start];
-            (p.pos, foot.yaw(&quat(p)))
-        }
-        Anchor::PhaseMean => {
-            let n = range.len() as f64;
-            let (mut sum, mut s, mut c) = (Vector3::zeros(), 0.0, 0.0);
-            for p in &free[range] {
-                sum += p.pos;
-                let yaw = foot.yaw(&quat(p));
-                (s, c) = (s + yaw.sin(), c + yaw.cos());
-            }
-            (sum / n, s.atan2(c))
+    let frames: Vec<usize> = match kind {
+        Anchor::PhaseStart => vec![range.start],
+        Anchor::PhaseMean => range.collect(),
+    };
+    let (mut s, mut c) = (0.0, 0.0);
+    for &t in &frames {
+        let yaws = std::iter::once(foot.yaw(&quat(&free[t]))).chain(shin[t].map(|q| foot.yaw(&q)));
+        for yaw in yaws {
+            (s, c) = (s + yaw.sin(), c + yaw.cos());
         }
     }
+    let yaw = s.atan2(c);
+    let flat = foot.flat(yaw);
+    let mut sum = Vector3::zeros();
+    for &t in &frames {
+        let q = anchored(foot, &free[t], yaw);
+        let low = foot.sole_low_point(&q);
+        sum += free[t].pos + q * low - flat * low;
+    }
+    (sum / frames.len().max(1) as f64, yaw)
 }
 
-/// The planted pose: the anchor's x, y and yaw, the free target's tilt, and the height that
-/// rests the sole's lowest point at `clearance`.
+/// The free target's orientation turned about world z to yaw `yaw`.
+fn anchored(foot: &RobotFoot, free: &Pose, yaw: f64) -> UnitQuaternion<f64> {
+    let q = quat(free);
+    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), wrap(yaw - foot.yaw(&q))) * q
+}
+
+/// The planted pose: the free target's tilt with the anchor's yaw, rolled over the sole's
+/// lowest point, which stays where it is on the flat foot at the anchor and rests at
+/// `clearance` above the floor.
 fn planted_pose(
     foot: &RobotFoot,
     free: &Pose,
@@ -297,14 +436,13 @@ fn planted_pose(
     yaw: f64,
     clearance: f64,
 ) -> Pose {
-    let q = quat(free);
-    let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), wrap(yaw - foot.yaw(&q)));
-    let planted = turn * q;
-    let z = clearance - foot.sole_offset(&planted);
-    Pose {
-        quat: [planted.w, planted.i, planted.j, planted.k],
-        pos: Vector3::new(anchor.x, anchor.y, z),
-    }
+    let q = anchored(foot, free, yaw);
+    let flat = foot.flat(yaw);
+    let low = foot.sole_low_point(&q);
+    let contact = Vector3::new(anchor.x, anchor.y, 0.0) + flat * low;
+    let rolled = q * low;
+    let pos = Vector3::new(contact.x - rolled.x, contact.y - rolled.y, clearance - rolled.z);
+    Pose { quat: [q.w, q.i, q.j, q.k], pos }
 }
 
 fn wrap(a: f64) -> f64 {

@@ -7,6 +7,7 @@ pub mod constraints;
 pub mod contact;
 pub mod derive;
 pub mod feet;
+pub mod joint_speed;
 pub mod lie;
 pub mod motion;
 pub mod pipeline;

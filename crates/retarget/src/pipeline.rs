@@ -5,15 +5,15 @@ use std::time::Instant;
 
 use bvh::Bvh;
 use fk::{FkOptions, HumanMotion};
-use mjcf::Model;
+use mjcf::{JointType, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
-use crate::constraints::Ground;
+use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
 use crate::lie::Pose;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
-use crate::solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};
+use crate::solver::{FrameDiagnostics, PointTask, Solver, SolverOptions, TaskSpec};
 use crate::targets::TargetMap;
 
 /// Everything that can go wrong in the retargeting crate.
@@ -80,9 +80,24 @@ pub struct PlausibleOptions {
     pub floor: f64,
     /// Hold the joints' speed limits (`mjcf::Joint::velocity_limit`) as hard bounds.
     pub speed_limits: SpeedLimits,
-    /// [`SolverOptions::smoothing`] and [`SolverOptions::root_smoothing`] of this solve.
-    pub smoothing: f64,
-    pub root_smoothing: f64,
+    /// Keep the robot's own geoms apart ([`crate::constraints::SelfCollision`]).
+    pub self_collision: SelfCollisionMode,
+    /// Passes of the zero-phase `[1, 2, 1] / 4` filter over the solved trajectory, after
+    /// which every frame is repaired (constraints and contacts held again) with
+    /// [`Solver::repair_frame`]; 0: no filtering.
+    pub smoothing_passes: usize,
+    /// [`Solver::repair_frame`]'s weight and steps.
+    pub repair_weight: f64,
+    pub repair_steps: usize,
+    /// [`SolverOptions::max_extra_steps`] of this solve (GMR: 10).
+    pub max_extra_steps: usize,
+}
+
+/// Whether the solve keeps the robot's geoms apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelfCollisionMode {
+    On,
+    Off,
 }
 
 /// Whether the solve holds the robot's joint speed limits.
@@ -100,8 +115,11 @@ impl Default for PlausibleOptions {
             feet: crate::feet::FootPlanOptions::default(),
             floor: 0.0,
             speed_limits: SpeedLimits::Robot,
-            smoothing: 20.0,
-            root_smoothing: 60.0,
+            self_collision: SelfCollisionMode::On,
+            smoothing_passes: 1,
+            repair_weight: 1000.0,
+            repair_steps: 2,
+            max_extra_steps: 10,
         }
     }
 }
@@ -321,16 +339,25 @@ impl<'a> Prepared<'a> {
         self.contacts = Some(contacts);
     }
 
+    fn contact_weight(&self) -> f64 {
+        match &self.options.mode {
+            SolveMode::Plausible(p) => p.feet.contact_weight,
+            SolveMode::Gmr => 0.0,
+        }
+    }
+
     /// A solver for this clip: GMR's, or with the default mode's constraints.
     fn solver(&self) -> Result<Solver<'a>, Error> {
         let mut options = self.options.solver.clone();
         if let SolveMode::Plausible(p) = &self.options.mode {
-            options.smoothing = p.smoothing;
-            options.root_smoothing = p.root_smoothing;
+            options.max_extra_steps = p.max_extra_steps;
         }
         let mut solver = Solver::new(self.model, &self.stages, options)?;
         if let SolveMode::Plausible(p) = &self.options.mode {
             solver.add_constraint(Box::new(Ground::new(self.model, p.floor)));
+            if p.self_collision == SelfCollisionMode::On {
+                solver.add_constraint(Box::new(SelfCollision::new(self.model)));
+            }
             if p.speed_limits == SpeedLimits::Robot {
                 let limits: Vec<Option<f64>> =
                     self.model.joints.iter().map(|j| j.velocity_limit).collect();
@@ -346,30 +373,111 @@ impl<'a> Prepared<'a> {
         let mut solver = self.solver()?;
         let nq = self.model.nq;
         let first = range.start.saturating_sub(lead_in);
-        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
-        let mut qpos = Vec::with_capacity(range.len() * nq);
-        let mut frames = Vec::with_capacity(range.len());
-        for f in first..range.end {
-            if let Some((bodies, plan)) = &self.plan {
-                for (body, w) in bodies.iter().zip(plan.weight[f]) {
-                    if let Some(body) = body {
-                        solver.set_weight_scale(*body, w, 1.0);
-                    }
-                }
+        // The smoothing filter looks one frame ahead per pass: solve that far past the range
+        // (when the clip goes on) so the range's last frames are filtered as in one pass.
+        let passes = match &self.options.mode {
+            SolveMode::Plausible(p) => p.smoothing_passes,
+            SolveMode::Gmr => 0,
+        };
+        let end = (range.end + passes).min(self.num_frames());
+        if matches!(self.options.mode, SolveMode::Plausible(_)) {
+            if let Some(start) = self.start_pose(first) {
+                solver.set_qpos(&start)?;
             }
-            let diag = solver.solve_frame(&self.targets[f * self.slots..(f + 1) * self.slots], dt);
+        }
+        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
+        let mut qpos = Vec::with_capacity((end - first) * nq);
+        let mut frames = Vec::with_capacity(end - first);
+        for f in first..end {
+            self.set_frame_tasks(&mut solver, f)?;
+            frames.push(solver.solve_frame(self.frame_targets(f), dt));
             if solver.qpos().iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     frame: f,
                     message: "the solver diverged".to_owned(),
                 });
             }
-            if f >= range.start {
-                qpos.extend_from_slice(solver.qpos());
-                frames.push(diag);
+            qpos.extend_from_slice(solver.qpos());
+        }
+        if let SolveMode::Plausible(p) = &self.options.mode {
+            if p.smoothing_passes > 0 && !qpos.is_empty() {
+                let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
+                solver.set_qpos(&smooth[..nq])?;
+                for (k, f) in (first..end).enumerate() {
+                    self.set_frame_tasks(&mut solver, f)?;
+                    let reference = &smooth[k * nq..(k + 1) * nq];
+                    let targets = self.frame_targets(f);
+                    solver.repair_frame(reference, targets, p.repair_weight, p.repair_steps, dt)?;
+                    qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
+                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f));
+                    (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
+                }
             }
         }
-        Ok(Solved { qpos, frames })
+        let skip = range.start - first;
+        qpos.truncate((range.end - first) * nq);
+        frames.truncate(range.end - first);
+        Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
+    }
+
+    /// `qpos0` with the free root moved to frame `f`'s target of the root body and turned to
+    /// its heading (about world z), so that a solve starting far from the origin, or facing
+    /// away from the robot's rest heading, starts where the motion is. `None` without a free
+    /// root or a task on its body.
+    fn start_pose(&self, f: usize) -> Option<Vec<f64>> {
+        let model = self.model;
+        let root = model.joints.iter().find(|j| j.kind == JointType::Free)?;
+        let &(_, slot) = self.tracked.iter().find(|(b, _)| *b == root.body)?;
+        let target = self.targets.get(f * self.slots + slot)?;
+        let mut q = model.qpos0.clone();
+        let a = root.qpos_adr;
+        let rest = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            q[a + 3],
+            q[a + 4],
+            q[a + 5],
+            q[a + 6],
+        ));
+        let goal = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            target.quat[0],
+            target.quat[1],
+            target.quat[2],
+            target.quat[3],
+        ));
+        // The heading change that turns the rest forward axis onto the target's.
+        let heading = |r: &nalgebra::UnitQuaternion<f64>| {
+            let f = r * (rest.inverse() * Vector3::x());
+            f.y.atan2(f.x)
+        };
+        let turn = nalgebra::UnitQuaternion::from_axis_angle(
+            &Vector3::z_axis(),
+            heading(&goal) - heading(&rest),
+        );
+        let start = turn * rest;
+        q[a] = target.pos.x;
+        q[a + 1] = target.pos.y;
+        q[a + 3..a + 7].copy_from_slice(&[start.w, start.i, start.j, start.k]);
+        Some(q)
+    }
+
+    fn frame_targets(&self, f: usize) -> &[Pose] {
+        &self.targets[f * self.slots..(f + 1) * self.slots]
+    }
+
+    /// Frame `f`'s foot weight factors and contact-point tasks (default mode).
+    fn set_frame_tasks(&self, solver: &mut Solver<'_>, f: usize) -> Result<(), Error> {
+        let Some((bodies, plan)) = &self.plan else { return Ok(()) };
+        let mut points = Vec::with_capacity(8);
+        let w = self.contact_weight();
+        for ((body, scale), contact) in bodies.iter().zip(plan.weight[f]).zip(&plan.contact[f]) {
+            let Some(body) = *body else { continue };
+            solver.set_weight_scale(body, scale, 1.0);
+            for p in contact {
+                let (h, v) = (w * p.horizontal, w * p.vertical);
+                let weight = Vector3::new(h, h, v);
+                points.push(PointTask { body, point: p.point, target: p.at, weight });
+            }
+        }
+        solver.set_point_tasks(&points)
     }
 
     /// The clip's motion and diagnostics from its solved frames (all of them, in order).
@@ -441,23 +549,63 @@ impl<'a> Prepared<'a> {
     }
 }
 
+/// The trajectory `qpos` (`frames × nq`) filtered `passes` times by the zero-phase binomial
+/// kernel `[1, 2, 1] / 4` (end frames kept; quaternions renormalised): it damps the
+/// frame-to-frame jitter (the kernel cancels the highest frequency) without lag.
+fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize) -> Vec<f64> {
+    let nq = model.nq;
+    let frames = qpos.len() / nq.max(1);
+    let mut out = qpos.to_vec();
+    if frames < 3 {
+        return out;
+    }
+    let mut previous = out.clone();
+    for _ in 0..passes {
+        previous.copy_from_slice(&out);
+        for t in 1..frames - 1 {
+            for i in 0..nq {
+                let at = |u: usize| previous[u * nq + i];
+                out[t * nq + i] = 0.25 * at(t - 1) + 0.5 * at(t) + 0.25 * at(t + 1);
+            }
+        }
+    }
+    for joint in &model.joints {
+        let at = match joint.kind {
+            JointType::Free => joint.qpos_adr + 3,
+            JointType::Ball => joint.qpos_adr,
+            JointType::Hinge | JointType::Slide => continue,
+        };
+        for t in 0..frames {
+            let q = &mut out[t * nq + at..t * nq + at + 4];
+            let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if n > 0.0 {
+                q.iter_mut().for_each(|v| *v /= n);
+            }
+        }
+    }
+    out
+}
+
 /// The robot's two feet (sole bodies, as the report finds them) with the task that moves
 /// each: a task on the sole body itself, else on its nearest ancestor that has one.
 fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2] {
     let Ok(soles) = crate::report::detect_feet(model) else {
         return [None, None];
     };
-    soles.map(|sole| {
-        let mut body = sole;
-        loop {
-            if let Some(task) = stages.iter().flatten().find(|t| t.body == body) {
-                return RobotFoot::new(model, body, sole, task.target);
-            }
-            if body == 0 {
-                return None;
-            }
-            body = model.bodies[body].parent;
+    // The nearest body at or above `from` that has a task, with that task's target slot.
+    let tracked_ancestor = |mut body: usize| loop {
+        if let Some(task) = stages.iter().flatten().find(|t| t.body == body) {
+            return Some((body, task.target));
         }
+        if body == 0 {
+            return None;
+        }
+        body = model.bodies[body].parent;
+    };
+    soles.map(|sole| {
+        let (body, slot) = tracked_ancestor(sole)?;
+        let shin = tracked_ancestor(model.bodies[body].parent);
+        RobotFoot::new(model, body, sole, slot, shin)
     })
 }
 

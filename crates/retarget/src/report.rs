@@ -53,9 +53,10 @@
 //!   samples where the source foot is in contact, the share where the foot height `h` (above)
 //!   is above [`ReportOptions::stance_float_height`] (2 cm: **floating in stance**) and the
 //!   share with `h` within [`ReportOptions::sole_band`] ([−0.5, +1.0] cm).
-//! - **Self-collision** (not in holosoma): over [`mjcf::Model::collision_pairs`] between robot
-//!   geoms (primitives, neither on the world body), less the pairs already touching or
-//!   penetrating at `qpos0` (distance ≤ 0: the model's own design), frames with any pair deeper
+//! - **Self-collision** (not in holosoma): over [`mjcf::Model::self_collision_pairs`]
+//!   (MuJoCo's pairs between robot primitives, less the pairs of bodies adjacent through
+//!   bodies without geoms and the pairs already touching or penetrating at `qpos0`: the
+//!   model's own design; the solver keeps the same pairs apart), frames with any pair deeper
 //!   than [`ReportOptions::self_collision_depth`] (1 cm), frames with any penetration, the
 //!   largest depth and its pair ([`mjcf::geom_distance`]).
 //! - **Joint speed over limit**: per hinge or slide joint with a published
@@ -247,6 +248,9 @@ pub struct SelfCollision {
     pub pairs: usize,
     /// Pairs left out because they touch or overlap at `qpos0`.
     pub ignored_pairs: usize,
+    /// Pairs left out because their bodies are adjacent in effect (joined through bodies
+    /// without collision geoms; see [`mjcf::Model::self_collision_pairs`]).
+    pub adjacent_pairs: usize,
     /// [`ReportOptions::self_collision_depth`] (cm).
     pub deep_cm: f64,
     /// Frames with a pair deeper than `deep_cm`.
@@ -394,15 +398,8 @@ fn collisions(
         })
         .collect();
     let mut data = mjcf::Data::new(model);
-    model.kinematics(&model.qpos0, &mut data);
-    let all_pairs: Vec<[usize; 2]> = model
-        .collision_pairs()
-        .into_iter()
-        .filter(|p| robot_geom(p[0]) && robot_geom(p[1]))
-        .collect();
-    let (pairs, ignored): (Vec<[usize; 2]>, Vec<[usize; 2]>) = all_pairs
-        .iter()
-        .partition(|p| mjcf::geom_distance(model, &data, p[0], p[1], 0.0).is_none());
+    let selection = model.self_collision_pairs();
+    let pairs = selection.pairs;
     let mut ground = GroundPenetration {
         geoms: geoms.len(),
         tolerance_cm: opts.penetration_tolerance * 100.0,
@@ -413,7 +410,8 @@ fn collisions(
     };
     let mut own = SelfCollision {
         pairs: pairs.len(),
-        ignored_pairs: ignored.len(),
+        ignored_pairs: selection.touching_at_rest.len(),
+        adjacent_pairs: selection.adjacent.len(),
         deep_cm: opts.self_collision_depth * 100.0,
         frames_deep: 0,
         frames_penetrating: 0,
@@ -900,14 +898,15 @@ impl QualityReport {
         let s = &self.self_collision;
         writeln!(
             f,
-            "self-collision: {} frames deeper than {:.1} cm, {} penetrating, max {:.2} cm{}; {} pairs ({} touching at qpos0 left out)",
+            "self-collision: {} frames deeper than {:.1} cm, {} penetrating, max {:.2} cm{}; {} pairs ({} touching at qpos0, {} adjacent left out)",
             s.frames_deep,
             s.deep_cm,
             s.frames_penetrating,
             s.max_depth_cm,
             s.worst_pair.as_ref().map(|[a, b]| format!(" ({a} / {b})")).unwrap_or_default(),
             s.pairs,
-            s.ignored_pairs
+            s.ignored_pairs,
+            s.adjacent_pairs
         )?;
         match &self.skating {
             Some(k) => writeln!(

@@ -41,13 +41,6 @@ pub struct SolverOptions {
     /// (GMR constructs a velocity limit but mink 1.3.0 ignores it, see `solve_ik`'s
     /// positional arguments). When set, `|q − q_previous frame| ≤ max_joint_speed · dt`.
     pub max_joint_speed: Option<f64>,
-    /// Weight `w` of a smoothness term `½ w |q − (2 q₋₁ − q₋₂)|²` on hinge and slide joints
-    /// (`q₋₁`, `q₋₂`: the two previous frames' solutions): it penalises joint acceleration.
-    /// GMR: 0 (none).
-    pub smoothing: f64,
-    /// The same for the free root: its position against `2 p₋₁ − p₋₂`, its orientation
-    /// (body-frame rotation vector) against `q₋₁ (q₋₂⁻¹ q₋₁)`. GMR: 0.
-    pub root_smoothing: f64,
 }
 
 impl Default for SolverOptions {
@@ -59,8 +52,6 @@ impl Default for SolverOptions {
             max_extra_steps: 10,
             limit_gain: 0.95,
             max_joint_speed: None,
-            smoothing: 0.0,
-            root_smoothing: 0.0,
         }
     }
 }
@@ -72,6 +63,20 @@ pub struct TaskSpec {
     pub target: usize,
     pub pos_weight: f64,
     pub rot_weight: f64,
+}
+
+/// A point fixed in a body that should be at a world position (e.g. a foot's contact point
+/// on its anchor): cost `½ Σ_axis w_axis² (target − p(q))_axis²` (world axes), in every
+/// stage of the frame's solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointTask {
+    pub body: usize,
+    /// In the body's frame.
+    pub point: nalgebra::Vector3<f64>,
+    /// World position (m).
+    pub target: nalgebra::Vector3<f64>,
+    /// Per world axis x, y, z.
+    pub weight: nalgebra::Vector3<f64>,
 }
 
 /// What one frame's solve did.
@@ -133,10 +138,6 @@ pub struct Solver<'m> {
     data: Data,
     qpos: Vec<f64>,
     previous: Vec<f64>,
-    /// The solution two frames back (for [`SolverOptions::smoothing`]).
-    before_previous: Vec<f64>,
-    /// Frames solved so far (the smoothing term needs two).
-    frames_solved: usize,
     dq: Vec<f64>,
     jacp: Vec<f64>,
     jacr: Vec<f64>,
@@ -147,6 +148,11 @@ pub struct Solver<'m> {
     /// Per dof: the speed limit of its joint (rad/s or m/s), if any.
     dof_speed: Vec<Option<f64>>,
     dense: DenseQp,
+    /// This frame's point tasks ([`Solver::set_point_tasks`]).
+    point_tasks: Vec<PointTask>,
+    /// Whether a general row was active in the last dense solve (then the next step goes
+    /// straight to the dense solver).
+    rows_bound: bool,
     relaxed_steps: usize,
 }
 
@@ -208,8 +214,6 @@ impl<'m> Solver<'m> {
             data: Data::new(model),
             qpos: model.qpos0.clone(),
             previous: model.qpos0.clone(),
-            before_previous: model.qpos0.clone(),
-            frames_solved: 0,
             dq: vec![0.0; nv],
             jacp: vec![0.0; 3 * nv],
             jacr: vec![0.0; 3 * nv],
@@ -218,6 +222,8 @@ impl<'m> Solver<'m> {
             constraints: Vec::new(),
             dof_speed: vec![None; nv],
             dense: DenseQp::new(nv),
+            point_tasks: Vec::new(),
+            rows_bound: false,
             relaxed_steps: 0,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
@@ -247,6 +253,16 @@ impl<'m> Solver<'m> {
                 self.dof_speed[joint.dof_adr] = *limit;
             }
         }
+        Ok(())
+    }
+
+    /// The point tasks of the next frames (replacing the previous ones; bodies must exist).
+    pub fn set_point_tasks(&mut self, tasks: &[PointTask]) -> Result<(), Error> {
+        if let Some(t) = tasks.iter().find(|t| t.body == 0 || t.body >= self.model.nbody()) {
+            return Err(Error::InvalidOption(format!("point task body {} is not a body", t.body)));
+        }
+        self.point_tasks.clear();
+        self.point_tasks.extend_from_slice(tasks);
         Ok(())
     }
 
@@ -286,9 +302,7 @@ impl<'m> Solver<'m> {
     /// Solves one frame from the current configuration. `targets` are indexed by the task
     /// specs' `target`; `dt` (seconds per frame) is used by `max_joint_speed` only.
     pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> FrameDiagnostics {
-        std::mem::swap(&mut self.before_previous, &mut self.previous);
         self.previous.copy_from_slice(&self.qpos);
-        self.frames_solved += 1;
         self.qp_failures = 0;
         self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
@@ -361,7 +375,7 @@ impl<'m> Solver<'m> {
                 self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
             }
         }
-        self.add_smoothing();
+        self.add_point_tasks();
         self.set_bounds(dt);
         let status = if self.constraints.is_empty() {
             let status = self.qp.solve();
@@ -393,10 +407,13 @@ impl<'m> Solver<'m> {
             c.add_rows(&ctx, &mut self.dense);
             ends.push(self.dense.num_rows());
         }
-        let status = self.qp.solve();
-        if status == QpStatus::Optimal && self.dense.rows_hold(&self.qp.x) {
-            self.dq.copy_from_slice(&self.qp.x);
-            return status;
+        // The box-only solve is cheaper; skip it while the rows keep binding.
+        if !self.rows_bound {
+            let status = self.qp.solve();
+            if status == QpStatus::Optimal && self.dense.rows_hold(&self.qp.x) {
+                self.dq.copy_from_slice(&self.qp.x);
+                return status;
+            }
         }
         self.dense.h.copy_from_slice(&self.qp.h);
         self.dense.c.copy_from_slice(&self.qp.c);
@@ -408,6 +425,7 @@ impl<'m> Solver<'m> {
             status = self.relax(&ends);
         }
         self.dq.copy_from_slice(&self.dense.x);
+        self.rows_bound = (0..self.dense.num_rows()).any(|k| self.dense.row_is_active(k));
         status
     }
 
@@ -467,50 +485,126 @@ impl<'m> Solver<'m> {
         self.options.lm_damping * mu
     }
 
-    /// The smoothness term: `w (q − p)` into c and `w` on the diagonal of H, with the
-    /// constant-velocity prediction `p = 2 q₋₁ − q₋₂` (from the third frame on).
-    fn add_smoothing(&mut self) {
-        let w = self.options.smoothing;
-        if (w <= 0.0 && self.options.root_smoothing <= 0.0) || self.frames_solved < 3 {
-            return;
+    /// `w² JᵀJ` into H and `−w² Jᵀ e` into c for each point task (`J`: the point's
+    /// translational Jacobian, `e = target − p`).
+    fn add_point_tasks(&mut self) {
+        let nv = self.model.nv;
+        for k in 0..self.point_tasks.len() {
+            let task = self.point_tasks[k];
+            let b = task.body;
+            let p = self.data.xpos[b] + self.data.xmat[b] * task.point;
+            let e = task.target - p;
+            self.model.jac(&self.data, b, &p, &mut self.jacp, &mut self.jacr);
+            let w2 = task.weight.component_mul(&task.weight);
+            let dofs: Vec<usize> = self.model.body_dofs(b).collect();
+            for &i in &dofs {
+                let ji = [self.jacp[i], self.jacp[nv + i], self.jacp[2 * nv + i]];
+                self.qp.c[i] -= w2.x * ji[0] * e.x + w2.y * ji[1] * e.y + w2.z * ji[2] * e.z;
+                for &j in &dofs {
+                    let jj = [self.jacp[j], self.jacp[nv + j], self.jacp[2 * nv + j]];
+                    self.qp.h[i * nv + j] +=
+                        w2.x * ji[0] * jj[0] + w2.y * ji[1] * jj[1] + w2.z * ji[2] * jj[2];
+                }
+            }
         }
+    }
+
+    /// `½ w |q ⊖ reference|²` (the free root's rotation as a body-frame rotation vector):
+    /// `w` on the diagonal of H and `w (q ⊖ reference)` into c.
+    fn add_posture(&mut self, reference: &[f64], w: f64) {
         let nv = self.model.nv;
         for joint in &self.model.joints {
             let (d, a) = (joint.dof_adr, joint.qpos_adr);
-            match joint.kind {
-                JointType::Hinge | JointType::Slide if w > 0.0 => {
-                    let predicted = 2.0 * self.previous[a] - self.before_previous[a];
-                    self.qp.h[d * nv + d] += w;
-                    self.qp.c[d] += w * (self.qpos[a] - predicted);
-                }
-                JointType::Free if self.options.root_smoothing > 0.0 => {
-                    let wr = self.options.root_smoothing;
-                    for k in 0..3 {
-                        let predicted = 2.0 * self.previous[a + k] - self.before_previous[a + k];
-                        self.qp.h[(d + k) * nv + d + k] += wr;
-                        self.qp.c[d + k] += wr * (self.qpos[a + k] - predicted);
-                    }
-                    let quat = |v: &[f64]| {
-                        nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
-                            v[a + 3],
-                            v[a + 4],
-                            v[a + 5],
-                            v[a + 6],
-                        ))
-                    };
-                    let (q, q1, q2) =
-                        (quat(&self.qpos), quat(&self.previous), quat(&self.before_previous));
-                    let predicted = q1 * (q2.inverse() * q1);
-                    // Body-frame rotation from q to the prediction.
-                    let e = (q.inverse() * predicted).scaled_axis();
-                    for k in 0..3 {
-                        self.qp.h[(d + 3 + k) * nv + d + 3 + k] += wr;
-                        self.qp.c[d + 3 + k] -= wr * e[k];
-                    }
-                }
-                _ => {}
+            let n = match joint.kind {
+                JointType::Hinge | JointType::Slide => 1,
+                JointType::Free => 3,
+                JointType::Ball => 0,
+            };
+            for k in 0..n {
+                self.qp.h[(d + k) * nv + d + k] += w;
+                self.qp.c[d + k] += w * (self.qpos[a + k] - reference[a + k]);
+            }
+            let rot_at = match joint.kind {
+                JointType::Free => (a + 3, d + 3),
+                JointType::Ball => (a, d),
+                JointType::Hinge | JointType::Slide => continue,
+            };
+            let quat = |v: &[f64]| {
+                let at = rot_at.0;
+                nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+                    v[at],
+                    v[at + 1],
+                    v[at + 2],
+                    v[at + 3],
+                ))
+            };
+            // Body-frame rotation from the current orientation to the reference.
+            let e = (quat(&self.qpos).inverse() * quat(reference)).scaled_axis();
+            for k in 0..3 {
+                let dk = rot_at.1 + k;
+                self.qp.h[dk * nv + dk] += w;
+                self.qp.c[dk] -= w * e[k];
             }
         }
+    }
+
+    /// Moves the solution of the frame just solved to `reference` (same frame; e.g. the
+    /// trajectory smoothed in time), then corrects it for the constraints and this frame's
+    /// point tasks with `steps` steps of the last stage's tasks (`targets`) plus a pull to
+    /// `reference` (weight `weight` per dof). The next frame's speed limits count from the
+    /// result.
+    pub fn repair_frame(
+        &mut self,
+        reference: &[f64],
+        targets: &[Pose],
+        weight: f64,
+        steps: usize,
+        dt: f64,
+    ) -> Result<(), Error> {
+        if reference.len() != self.model.nq || reference.iter().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidOption(format!(
+                "a reference configuration must be {} finite numbers",
+                self.model.nq
+            )));
+        }
+        self.qpos.copy_from_slice(reference);
+        self.model.kinematics(&self.qpos, &mut self.data);
+        let nv = self.model.nv;
+        for _ in 0..steps {
+            self.qp.h.fill(0.0);
+            self.qp.c.fill(0.0);
+            let mut mu_total = 0.0;
+            if let Some(s) = self.stages.len().checked_sub(1) {
+                self.stage_error(s, targets);
+                for k in 0..self.stages[s].len() {
+                    mu_total += self.task_objective(s, k, targets);
+                }
+            }
+            self.add_posture(reference, weight);
+            self.add_point_tasks();
+            for d in 0..nv {
+                self.qp.h[d * nv + d] += self.options.damping + mu_total;
+                for e in 0..d {
+                    self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
+                }
+            }
+            self.set_bounds(dt);
+            let status = self.constrained_step();
+            if !matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
+                self.qp_failures += 1;
+                break;
+            }
+            self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
+            self.model.kinematics(&self.qpos, &mut self.data);
+        }
+        self.previous.copy_from_slice(&self.qpos);
+        Ok(())
+    }
+
+    /// Tracking errors at the current configuration (as in [`FrameDiagnostics`]).
+    #[must_use]
+    pub fn errors(&self, targets: &[Pose]) -> (Vec<f64>, Vec<f64>) {
+        self.tracking_errors(targets)
     }
 
     /// Joint-range bounds on Δq, intersected with the speed limits (per joint, or the global
@@ -604,11 +698,7 @@ fn check_options(o: &SolverOptions) -> Result<(), Error> {
         && o.stop_threshold.is_finite()
         && o.limit_gain > 0.0
         && o.limit_gain <= 1.0
-        && o.max_joint_speed.is_none_or(|v| v.is_finite() && v > 0.0)
-        && o.smoothing.is_finite()
-        && o.smoothing >= 0.0
-        && o.root_smoothing.is_finite()
-        && o.root_smoothing >= 0.0;
+        && o.max_joint_speed.is_none_or(|v| v.is_finite() && v > 0.0);
     if ok {
         Ok(())
     } else {

@@ -53,6 +53,9 @@ pub struct DenseQp {
     /// `R` by columns: `r[k n + i] = R[i][k]`, upper triangular in the first `active.len()`.
     r: Vec<f64>,
     active: Vec<Con>,
+    /// Per variable: lower / upper bound active; per row: active (mirrors `active`).
+    bound_active: Vec<[bool; 2]>,
+    row_active: Vec<bool>,
     /// Multipliers of the active constraints (same order), and of the one being added.
     u: Vec<f64>,
     d: Vec<f64>,
@@ -79,6 +82,8 @@ impl DenseQp {
             jt: vec![0.0; n * n],
             r: vec![0.0; n * n],
             active: Vec::with_capacity(n),
+            bound_active: vec![[false; 2]; n],
+            row_active: Vec::new(),
             u: Vec::with_capacity(n + 1),
             d: vec![0.0; n],
             z: vec![0.0; n],
@@ -125,6 +130,12 @@ impl DenseQp {
         &mut self.a[start..]
     }
 
+    /// Row `k`: `(a, b)` of `a · x ≥ b`.
+    #[must_use]
+    pub fn row(&self, k: usize) -> Option<(&[f64], f64)> {
+        Some((self.a.get(k * self.n..(k + 1) * self.n)?, *self.b.get(k)?))
+    }
+
     /// Rows stored (in use or not).
     #[must_use]
     pub fn num_rows(&self) -> usize {
@@ -134,7 +145,7 @@ impl DenseQp {
     /// Whether general row `k` is in the final active set.
     #[must_use]
     pub fn row_is_active(&self, k: usize) -> bool {
-        self.active.contains(&Con::Row(k))
+        self.row_active.get(k).copied().unwrap_or(false)
     }
 
     /// Solves the problem currently stored; the minimiser is left in `x`. On
@@ -144,6 +155,9 @@ impl DenseQp {
         self.iterations = 0;
         self.active.clear();
         self.u.clear();
+        self.bound_active.fill([false; 2]);
+        self.row_active.clear();
+        self.row_active.resize(self.b.len(), false);
         let m = self.in_use;
         let finite_data = self.c.iter().chain(&self.b[..m]).chain(&self.a[..m * self.n]);
         let finite_data = finite_data.into_iter().all(|v| v.is_finite());
@@ -166,39 +180,45 @@ impl DenseQp {
         QpStatus::Optimal
     }
 
-    /// `H = L Lᵀ`, then `J = L⁻ᵀ` (its column `k` is row `k` of `L⁻¹`).
+    /// `H = L Lᵀ`, then `J = L⁻ᵀ` (its column `k` is row `k` of `L⁻¹`). Row slices and
+    /// skipped zeros keep it fast on the kinematic tree's sparsity (no fill-in: most of `L`'s
+    /// lower triangle is zero).
     fn factor(&mut self) -> bool {
         let n = self.n;
-        // Cholesky into `r` as scratch (row-major lower triangle).
+        // Cholesky into `r` as scratch (row-major lower triangle), row by row.
         let l = &mut self.r;
+        l.copy_from_slice(&self.h);
+        let inv = &mut self.z; // 1 / L[j][j], scratch until the first iteration
         for i in 0..n {
-            for j in 0..=i {
-                let mut s = self.h[i * n + j];
-                for k in 0..j {
-                    s -= l[i * n + k] * l[j * n + k];
-                }
-                if i == j {
-                    if !(s > 0.0 && s.is_finite()) {
-                        return false;
-                    }
-                    l[i * n + i] = s.sqrt();
-                } else {
-                    l[i * n + j] = s / l[j * n + j];
-                }
+            let (done, rest) = l.split_at_mut(i * n);
+            let row_i = &mut rest[..n];
+            for j in 0..i {
+                let row_j = &done[j * n..j * n + j];
+                row_i[j] = (row_i[j] - dot(&row_i[..j], row_j)) * inv[j];
             }
+            let d = row_i[i] - dot(&row_i[..i], &row_i[..i]);
+            if !(d > 0.0 && d.is_finite()) {
+                return false;
+            }
+            row_i[i] = d.sqrt();
+            inv[i] = 1.0 / row_i[i];
+            row_i[i + 1..].fill(0.0);
         }
-        // Rows of L⁻¹ by forward substitution: Linv[i][j] = −Σ_{k=j}^{i−1} L[i][k] Linv[k][j] / L[i][i].
+        // Rows of L⁻¹: row i = (e_i − Σ_{k<i} L[i][k] row_k) / L[i][i], row k non-zero in ..=k.
         let jt = &mut self.jt;
         jt.fill(0.0);
         for i in 0..n {
-            let lii = l[i * n + i];
-            jt[i * n + i] = 1.0 / lii;
-            for j in 0..i {
-                let mut s = 0.0;
-                for k in j..i {
-                    s += l[i * n + k] * jt[k * n + j];
+            let inv_lii = self.z[i];
+            let (done, rest) = jt.split_at_mut(i * n);
+            let row_i = &mut rest[..n];
+            row_i[i] = inv_lii;
+            for k in 0..i {
+                let f = l[i * n + k] * inv_lii;
+                if f != 0.0 {
+                    for (x, y) in row_i[..=k].iter_mut().zip(&done[k * n..k * n + k + 1]) {
+                        *x -= f * y;
+                    }
                 }
-                jt[i * n + j] = -s / lii;
             }
         }
         self.r.fill(0.0);
@@ -241,15 +261,16 @@ impl DenseQp {
             }
         };
         for i in 0..n {
-            if self.lb[i] > f64::NEG_INFINITY && !self.active.contains(&Con::Lower(i)) {
+            let [lower, upper] = self.bound_active[i];
+            if self.lb[i] > f64::NEG_INFINITY && !lower {
                 consider(Con::Lower(i), self.x[i] - self.lb[i], 1.0, self.lb[i].abs());
             }
-            if self.ub[i] < f64::INFINITY && !self.active.contains(&Con::Upper(i)) {
+            if self.ub[i] < f64::INFINITY && !upper {
                 consider(Con::Upper(i), self.ub[i] - self.x[i], 1.0, self.ub[i].abs());
             }
         }
         for k in 0..self.in_use {
-            if self.active.contains(&Con::Row(k)) {
+            if self.row_active[k] {
                 continue;
             }
             let row = &self.a[k * n..(k + 1) * n];
@@ -292,8 +313,18 @@ impl DenseQp {
             }
             let q = self.active.len();
             // d = Jᵀ n_p; z = J₂ d₂ (primal direction); r = R⁻¹ d₁ (dual direction).
-            for k in 0..n {
-                self.d[k] = dot(&self.jt[k * n..(k + 1) * n], &self.normal);
+            match p {
+                Con::Lower(i) | Con::Upper(i) => {
+                    let sign = if matches!(p, Con::Lower(_)) { 1.0 } else { -1.0 };
+                    for k in 0..n {
+                        self.d[k] = sign * self.jt[k * n + i];
+                    }
+                }
+                Con::Row(_) => {
+                    for k in 0..n {
+                        self.d[k] = dot(&self.jt[k * n..(k + 1) * n], &self.normal);
+                    }
+                }
             }
             self.z.fill(0.0);
             for k in q..n {
@@ -364,7 +395,7 @@ impl DenseQp {
             if b == 0.0 {
                 continue;
             }
-            let h = a.hypot(b);
+            let h = (a * a + b * b).sqrt(); // no overflow at these magnitudes; faster than hypot
             let (cs, sn) = (a / h, b / h);
             self.d[i - 1] = h;
             self.d[i] = 0.0;
@@ -373,6 +404,7 @@ impl DenseQp {
         self.r[q * n..q * n + q + 1].copy_from_slice(&self.d[..=q]);
         self.active.push(con);
         self.u.push(multiplier);
+        self.set_flag(con, true);
     }
 
     /// Removes active constraint `i`: its column leaves `R`, the Hessenberg remainder is
@@ -380,7 +412,8 @@ impl DenseQp {
     fn drop_active(&mut self, i: usize) {
         let n = self.n;
         let q = self.active.len();
-        self.active.remove(i);
+        let con = self.active.remove(i);
+        self.set_flag(con, false);
         self.u.remove(i);
         for k in i..q - 1 {
             let (src, dst) = ((k + 1) * n, k * n);
@@ -393,7 +426,7 @@ impl DenseQp {
             if b == 0.0 {
                 continue;
             }
-            let h = a.hypot(b);
+            let h = (a * a + b * b).sqrt(); // no overflow at these magnitudes; faster than hypot
             let (cs, sn) = (a / h, b / h);
             for col in k..q - 1 {
                 let (x, y) = (self.r[col * n + k], self.r[col * n + k + 1]);
@@ -402,6 +435,16 @@ impl DenseQp {
             }
             self.r[k * n + k + 1] = 0.0;
             rotate_columns(&mut self.jt, n, k, k + 1, cs, sn);
+        }
+    }
+}
+
+impl DenseQp {
+    fn set_flag(&mut self, con: Con, on: bool) {
+        match con {
+            Con::Lower(i) => self.bound_active[i][0] = on,
+            Con::Upper(i) => self.bound_active[i][1] = on,
+            Con::Row(k) => self.row_active[k] = on,
         }
     }
 }
