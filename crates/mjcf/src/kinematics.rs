@@ -2,6 +2,12 @@
 //! `mj_jac`/`mj_jacBody` and `mj_integratePos` (engine_core_smooth.c, engine_support.c),
 //! analytic and allocation-free.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: every index in this module is one `Model` itself holds
+// (parents before children, dof and qpos addresses inside nv and nq: the compilers build
+// them so), and `Data` is sized from the same model. This is the solver's per-iteration
+// hot loop (the kinematics benchmark), so it indexes instead of re-checking each access.
+#![allow(clippy::indexing_slicing)]
+
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::math::axis_angle;
