@@ -189,14 +189,12 @@ impl ClipDiagnostics {
     fn stats(&self, value: impl Fn(&FrameDiagnostics, usize) -> f64) -> Vec<(f64, f64)> {
         (0..self.body_names.len())
             .map(|k| {
-                let mut v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
+                let v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
                 if v.is_empty() {
                     return (0.0, 0.0);
                 }
                 let mean = v.iter().sum::<f64>() / v.len() as f64;
-                v.sort_by(f64::total_cmp);
-                let idx = ((v.len() as f64 - 1.0) * 0.95).round() as usize;
-                (mean, v[idx.min(v.len() - 1)])
+                (mean, crate::report::percentile(&v, 0.95))
             })
             .collect()
     }
@@ -273,6 +271,7 @@ impl<'a> Prepared<'a> {
         config: &IkConfig,
         options: &'a RetargetOptions,
     ) -> Result<Prepared<'a>, Error> {
+        human.validate()?;
         let height = options
             .human_height
             .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
@@ -281,13 +280,6 @@ impl<'a> Prepared<'a> {
         let stages = task_specs(config, model, &map);
         let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
         let (nb, nf) = (human.num_bodies(), human.num_frames);
-        if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
-            return Err(Error::InvalidOption(format!(
-                "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
-                human.positions.len(),
-                human.orientations.len()
-            )));
-        }
         let slots = map.bodies.len();
         let mut targets =
             vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
