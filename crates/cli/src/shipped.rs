@@ -51,10 +51,8 @@ pub fn robot_model(name_or_path: &str) -> anyhow::Result<mjcf::Model> {
         JointSpeedLimits::from_json_str(speeds, &origin)?.apply(&mut model, &origin)?;
         return Ok(model);
     }
-    let path = Path::new(name_or_path);
-    let looks_like_path =
-        path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR);
-    if path.is_file() || looks_like_path {
+    if looks_like_path(name_or_path) {
+        let path = Path::new(name_or_path);
         let mut model = mjcf::Model::from_path(path)?;
         let speeds = path.with_file_name("joint_speed_limits.json");
         if speeds.is_file() {
@@ -64,9 +62,28 @@ pub fn robot_model(name_or_path: &str) -> anyhow::Result<mjcf::Model> {
         }
         return Ok(model);
     }
+    Err(unknown_robot(name_or_path))
+}
+
+/// Whether a `--robot` argument names a model file rather than a shipped robot.
+pub fn looks_like_path(name_or_path: &str) -> bool {
+    let path = Path::new(name_or_path);
+    path.is_file() || path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR)
+}
+
+/// The error for a `--robot` that is neither a shipped robot nor a model file: the shipped
+/// robots, and the nearest one by name when one is close (Jaro-Winkler similarity ≥ 0.7, as
+/// clap suggests subcommands).
+pub fn unknown_robot(name: &str) -> anyhow::Error {
     let keys: Vec<&str> = shipped_keys().collect();
-    anyhow::bail!(
-        "unknown robot \"{name_or_path}\": not a shipped robot ({}) and not an MJCF or URDF file",
+    let nearest = keys
+        .iter()
+        .map(|k| (strsim::jaro_winkler(name, k), *k))
+        .filter(|(score, _)| *score >= 0.7)
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    let hint = nearest.map_or(String::new(), |(_, k)| format!("; did you mean {k}?"));
+    anyhow::anyhow!(
+        "unknown robot \"{name}\": not a shipped robot ({}) nor an MJCF (.xml) or URDF (.urdf) file{hint}",
         keys.join(", ")
     )
 }
@@ -89,5 +106,10 @@ mod tests {
     fn unknown_names_list_the_shipped_robots() {
         let message = robot_model("no_such_robot").unwrap_err().to_string();
         assert!(message.contains("unitree_g1"), "{message}");
+        assert!(!message.contains("did you mean"), "nothing is near: {message}");
+        let message = robot_model("unitre_g1").unwrap_err().to_string();
+        assert!(message.ends_with("; did you mean unitree_g1?"), "{message}");
+        let message = robot_model("fourier").unwrap_err().to_string();
+        assert!(message.ends_with("; did you mean fourier_n1?"), "{message}");
     }
 }

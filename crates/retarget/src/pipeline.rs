@@ -118,7 +118,7 @@ impl Default for PlausibleOptions {
             self_collision: SelfCollisionMode::On,
             smoothing_passes: 1,
             repair_weight: 1000.0,
-            repair_steps: 2,
+            repair_steps: 1,
             max_extra_steps: 10,
         }
     }
@@ -189,14 +189,12 @@ impl ClipDiagnostics {
     fn stats(&self, value: impl Fn(&FrameDiagnostics, usize) -> f64) -> Vec<(f64, f64)> {
         (0..self.body_names.len())
             .map(|k| {
-                let mut v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
+                let v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
                 if v.is_empty() {
                     return (0.0, 0.0);
                 }
                 let mean = v.iter().sum::<f64>() / v.len() as f64;
-                v.sort_by(f64::total_cmp);
-                let idx = ((v.len() as f64 - 1.0) * 0.95).round() as usize;
-                (mean, v[idx.min(v.len() - 1)])
+                (mean, crate::report::percentile(&v, 0.95))
             })
             .collect()
     }
@@ -273,6 +271,7 @@ impl<'a> Prepared<'a> {
         config: &IkConfig,
         options: &'a RetargetOptions,
     ) -> Result<Prepared<'a>, Error> {
+        human.validate()?;
         let height = options
             .human_height
             .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
@@ -281,13 +280,6 @@ impl<'a> Prepared<'a> {
         let stages = task_specs(config, model, &map);
         let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
         let (nb, nf) = (human.num_bodies(), human.num_frames);
-        if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
-            return Err(Error::InvalidOption(format!(
-                "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
-                human.positions.len(),
-                human.orientations.len()
-            )));
-        }
         let slots = map.bodies.len();
         let mut targets =
             vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
@@ -313,30 +305,35 @@ impl<'a> Prepared<'a> {
             fps: human.fps,
             height,
         };
+        // The source's contact phases are written in both modes (GMR's solve ignores them);
+        // the default mode plants the feet on them.
+        let contact = match &options.mode {
+            SolveMode::Plausible(p) => p.contact.clone(),
+            SolveMode::Gmr => crate::contact::ContactOptions::default(),
+        };
+        if let Some(points) = crate::contact::human_foot_points(&human.body_names) {
+            prepared.contacts = Some(crate::contact::detect(human, points, &contact));
+        }
         if let SolveMode::Plausible(plausible) = &options.mode {
-            prepared.plan_feet(human, plausible);
+            prepared.plan_feet(plausible);
         }
         Ok(prepared)
     }
 
-    /// Source contacts, then planted foot targets (when both the human's and the robot's
+    /// Planted foot targets from the source contacts (when both the human's and the robot's
     /// feet are found; otherwise the targets stay GMR's and only the constraints apply).
-    fn plan_feet(&mut self, human: &HumanMotion, options: &PlausibleOptions) {
-        let Some(points) = crate::contact::human_foot_points(&human.body_names) else {
-            return;
-        };
-        let contacts = crate::contact::detect(human, points, &options.contact);
+    fn plan_feet(&mut self, options: &PlausibleOptions) {
+        let Some(contacts) = &self.contacts else { return };
         let feet = robot_feet(self.model, &self.stages);
         let plan = crate::feet::plan(
             &feet,
-            &contacts,
+            contacts,
             &mut self.targets,
             self.slots,
             self.fps,
             &options.feet,
         );
         self.plan = Some((feet.map(|f| f.map(|f| f.body)), plan));
-        self.contacts = Some(contacts);
     }
 
     fn contact_weight(&self) -> f64 {
@@ -388,6 +385,11 @@ impl<'a> Prepared<'a> {
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
+        // With a repair pass, the first pass tracks with joint ranges and speed limits only
+        // (box bounds: the fast QP); the repair pass holds the ground and self-collision.
+        if passes > 0 {
+            solver.hold_constraints(false);
+        }
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt));
@@ -402,12 +404,12 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(p) = &self.options.mode {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
+                solver.hold_constraints(true);
                 solver.set_qpos(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
-                    let targets = self.frame_targets(f);
-                    solver.repair_frame(reference, targets, p.repair_weight, p.repair_steps, dt)?;
+                    solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
                     let (pos_error, rot_error) = solver.errors(self.frame_targets(f));
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
