@@ -6,13 +6,15 @@
 //! hand; the head is not tracked, as in GMR's configs):
 //!
 //! - **Body ↔ joint**: the role's robot body tracks the role's human joint.
-//! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part:
+//! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part,
+//!   except the feet's position weight: 100 as in GMR's configs for the T1, N1, PM01 and
+//!   ToddlerBot (the G1's has 50):
 //!
 //!   | part | table 1 pos | table 1 rot | table 2 pos | table 2 rot |
 //!   |---|---|---|---|---|
 //!   | pelvis | 0 | 10 | 100 | 5 |
 //!   | thigh, shin | 0 | 10 | 10 | 5 |
-//!   | foot | 50 | 10 | 50 | 10 |
+//!   | foot | 100 | 10 | 100 | 10 |
 //!   | chest | 0 | 100 | 0 | 10 |
 //!   | upper arm | 0 | 100 | 5 | 100 |
 //!   | forearm, hand | 0 | 10 | 10 | 5 |
@@ -21,11 +23,26 @@
 //!   human's frame offset ([`fk::Humanoid::frame_offsets`], identity for the canonical human),
 //!   `C_r` the robot role's canonical frame and `q_body` its body's orientation at `qpos0`.
 //!   The target `q_joint ⊗ q_off = C_h ⊗ (C_r⁻¹ ⊗ q_body)` puts the robot body where the
-//!   human's canonical frame says, whatever either side's joint frames are.
-//! - **Position offset**, in the body's target frame: `q_body⁻¹ (x_body − p_r)`, the body's
-//!   origin seen from its role point `p_r` (a hip's joint centre, not the hip-yaw body's
-//!   origin 12 cm below it on the G1), so that the role point lands on the human joint; for
-//!   the pelvis also the human's hip midpoint seen from its pelvis joint, `s · q_off⁻¹ d_h`.
+//!   human's canonical frame says, whatever either side's joint frames are. Two refinements
+//!   of the frames: the robot's limbs are turned about their bones so that the knee flexes
+//!   about +y and the elbow about −y of the thigh / upper arm frame (the flexion sense is the
+//!   larger side of the hinge's range from straight), which is where a human's knee and
+//!   elbow bend when the arm hangs: a robot whose elbow bends sideways at `qpos0`
+//!   (ToddlerBot's) then bends it forward with the human's; and the human's foot frame is
+//!   turned to lie flat on average over the frames where the foot is flat on the floor
+//!   (a reference pose on tiptoe would otherwise stand the robot on its toes).
+//! - **Position offset**, in the body's target frame, **fitted to the motion**: the offset
+//!   that puts the target where the robot's body is when the robot copies the human's
+//!   posture, averaged over up to 256 sampled frames. The copy: the robot's pelvis point at
+//!   the scaled human hip midpoint, its role points hanging from it along the robot's own
+//!   segments, each turned by the human's canonical frame of that role (knee and elbow held
+//!   in their hinge ranges), the body origin at its offset from its role point; the target:
+//!   GMR's scaling of the human joint. A foot's offset is fitted over the postures where
+//!   it is flat, and then so that the robot's **sole is on the floor** wherever the human's
+//!   foot touches it (flat, on the heel, on the ball): least squares of the sole's lowest
+//!   point over those postures, with the foot turned as the human's. A robot sole longer
+//!   than the scaled human foot is thereby moved back, so that its toe does not dig in when
+//!   the human rolls onto the ball. The canonical human has one posture (standing).
 //! - **Scales**, robot over human: the root (pelvis) by the standing hip height (thigh +
 //!   shin + ankle height); the hip by its sideways offset from the pelvis point (midway
 //!   between the hips); the knee by the thigh, the foot by thigh + shin (with the root's
@@ -39,7 +56,8 @@
 //! (`pelvis`, `left_thigh`, …): a **role-named config**. [`bind`] turns it into one for a
 //! particular skeleton: names become the skeleton's joints, rotation offsets get the
 //! skeleton's frame offsets (`F_h ⊗ q_off`), scales are rescaled by canonical over skeleton
-//! path lengths, the pelvis offset gets the skeleton's hip midpoint, and the height
+//! path lengths, position offsets are fitted to the skeleton's motion (keeping what the file
+//! added to the canonical fit), and the height
 //! assumption becomes the skeleton's height (times any factor the file applied to the
 //! canonical one). Binding the role-named config of a robot gives exactly the config derived
 //! for that skeleton directly.
@@ -56,7 +74,8 @@ use crate::robot_roles::RobotRoles;
 
 use crate::Error;
 
-/// GMR's G1 weights per part: `[table1 pos, table1 rot, table2 pos, table2 rot]`.
+/// Weights per part (GMR's G1 config's, the feet's position GMR's other configs'):
+/// `[table1 pos, table1 rot, table2 pos, table2 rot]`.
 pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
     (Part::Pelvis, [0.0, 10.0, 100.0, 5.0]),
     (Part::Thigh, [0.0, 10.0, 10.0, 5.0]),
@@ -70,6 +89,9 @@ pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
 
 /// A foot counts as flat on the floor while its ankle is within this of its flat height (m).
 const FLAT_FOOT: f64 = 0.03;
+
+/// Frames of a motion sampled, evenly, for the proportions and the offset fits.
+const POSTURES: usize = 256;
 
 /// Height of the canonical human (m).
 pub const CANONICAL_HEIGHT: f64 = 1.75;
@@ -116,6 +138,10 @@ const SCALE_ORDER: [Role; 14] = [
 pub struct Posture {
     pub points: BTreeMap<Role, Vector3<f64>>,
     pub frames: BTreeMap<Role, UnitQuaternion<f64>>,
+    /// `[left, right]`: whether the foot touches the floor (its ankle or its toe joint within
+    /// [`FLAT_FOOT`] of the height it has when the foot is flat): flat, on the heel or on the
+    /// ball of the foot.
+    pub feet_down: [bool; 2],
 }
 
 /// The human half of a derived config: one skeleton's joint per role, its frame offsets and
@@ -130,7 +156,7 @@ pub struct HumanBody {
     /// through the role joints ([`module docs`](self)); the pelvis's entry is the standing hip
     /// height (thigh + shin + ankle height).
     pub paths: BTreeMap<Role, f64>,
-    /// Sampled postures (up to 64 frames of the motion; the canonical human has one): what
+    /// Sampled postures (up to 256 frames of the motion; the canonical human has one): what
     /// the position offsets are fitted to ([`module docs`](self)).
     pub postures: Vec<Posture>,
     /// Height of the floor in the motion (m, the fk ground estimate; 0 for the canonical
@@ -158,7 +184,11 @@ impl HumanBody {
             joints,
             frame_offsets,
             paths: paths(&points, ankle),
-            postures: vec![Posture { frames: fk::canonical_frames(&points), points: points.clone() }],
+            postures: vec![Posture {
+                frames: fk::canonical_frames(&points),
+                points: points.clone(),
+                feet_down: [true; 2],
+            }],
             ground: 0.0,
             ankle,
             height: CANONICAL_HEIGHT,
@@ -167,7 +197,7 @@ impl HumanBody {
     }
 
     /// The human half for a recognised skeleton and its motion (metres, Z up): frame offsets
-    /// from `humanoid`, proportions averaged over up to 64 frames, the ankle height from how
+    /// from `humanoid`, proportions averaged over up to 256 frames, the ankle height from how
     /// low the ankles go above `ground`, and `height` (the measured subject height).
     pub fn from_motion(
         humanoid: &Humanoid,
@@ -183,12 +213,12 @@ impl HumanBody {
         if n == 0 {
             return Err(Error::InvalidOption(format!("{source}: the motion has no frames")));
         }
-        let count = n.min(64);
+        let count = n.min(POSTURES);
         let picked: Vec<usize> =
             (0..count).map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 }).collect();
         let ankle = ankle_height(motion, [index(Role::LeftFoot), index(Role::RightFoot)], ground);
+        let toe = flat_height(motion, [index(Role::LeftToe), index(Role::RightToe)], ground);
         let mut frame_offsets = humanoid.frame_offsets.clone();
-        twist_limbs(motion, &index, &mut frame_offsets);
         for side in [Side::Left, Side::Right] {
             let foot = Role::of(Part::Foot, side);
             if let (Some(b), Some(offset)) = (index(foot), frame_offsets.get_mut(&foot)) {
@@ -209,7 +239,14 @@ impl HumanBody {
                 .iter()
                 .filter_map(|(r, offset)| Some((*r, motion.orientation(f, index(*r)?) * offset)))
                 .collect();
-            postures.push(Posture { points, frames });
+            let feet_down = [Side::Left, Side::Right].map(|side| {
+                let low = |part, flat: Option<f64>| {
+                    let z = points.get(&Role::of(part, side))?.z - ground;
+                    Some(z < flat? + FLAT_FOOT)
+                };
+                low(Part::Foot, Some(ankle)) == Some(true) || low(Part::Toe, toe) == Some(true)
+            });
+            postures.push(Posture { points, frames, feet_down });
         }
         let count = picked.len() as f64;
         let folds = trunk_folds(motion, humanoid, &picked, &index);
@@ -234,70 +271,6 @@ impl HumanBody {
             height,
             source: source.to_owned(),
         })
-    }
-}
-
-/// The limbs' canonical frames turned about their bones so that the knees flex about +y and
-/// the elbows about −y, as [`limb_frames`] turns the robot's: the flexion axis is the normal
-/// of the two bones (`proximal × distal`) averaged, in each bone's frame, over the frames
-/// where the joint bends more than 20°. The reference pose's forward direction fixes the
-/// twist of a bone only roughly (a forearm raised forward and turned in has its x wherever
-/// the palm was); the axis the joint really bends about makes the robot's knee and elbow
-/// bend where the human's do. Limbs that never bend keep their frames.
-fn twist_limbs(
-    motion: &HumanMotion,
-    index: &dyn Fn(Role) -> Option<usize>,
-    offsets: &mut BTreeMap<Role, UnitQuaternion<f64>>,
-) {
-    for side in [Side::Left, Side::Right] {
-        let limbs: [([Part; 3], &[Part], f64); 2] = [
-            ([Part::Thigh, Part::Shin, Part::Foot], &[Part::Thigh, Part::Shin], 1.0),
-            ([Part::UpperArm, Part::Forearm, Part::Hand], &[Part::UpperArm, Part::Forearm], -1.0),
-        ];
-        for (limb, bones, y_sign) in limbs {
-            let tw = std::env::var("TWIST").unwrap_or("both".into());
-            if tw == "none" || (tw == "arms" && limb[0] == Part::Thigh) || (tw == "legs" && limb[0] == Part::UpperArm) { continue; }
-            let roles = limb.map(|p| Role::of(p, side));
-            let Some(b) = roles.iter().map(|&r| index(r)).collect::<Option<Vec<_>>>() else {
-                continue;
-            };
-            let mut sums = [Vector3::zeros(); 2];
-            for f in 0..motion.num_frames {
-                let p = |i: usize| *motion.position(f, b[i]);
-                let (u, d) = (p(1) - p(0), p(2) - p(1));
-                if u.angle(&d) < 20f64.to_radians() {
-                    continue;
-                }
-                let Some(n) = u.cross(&d).try_normalize(1e-12) else { continue };
-                for (k, &part) in bones.iter().enumerate() {
-                    let role = Role::of(part, side);
-                    if let Some(o) = offsets.get(&role) {
-                        sums[k] += (motion.orientation(f, b[k]) * o).inverse() * n * y_sign;
-                    }
-                }
-            }
-            for (k, &part) in bones.iter().enumerate() {
-                // The turn about z that lays the axis (seen in the bone's frame) along +y.
-                let v = sums[k];
-                if v.x.hypot(v.y) < 1e-9 {
-                    continue;
-                }
-                let turn = UnitQuaternion::from_axis_angle(
-                    &Vector3::z_axis(),
-                    v.y.atan2(v.x) - std::f64::consts::FRAC_PI_2,
-                );
-                let mut roles = vec![Role::of(part, side)];
-                if part == Part::Forearm {
-                    // The hand's frame continues the forearm's.
-                    roles.push(Role::of(Part::Hand, side));
-                }
-                for role in roles {
-                    if let Some(o) = offsets.get_mut(&role) {
-                        *o *= turn;
-                    }
-                }
-            }
-        }
     }
 }
 
@@ -416,21 +389,24 @@ fn paths(points: &BTreeMap<Role, Vector3<f64>>, ankle: f64) -> BTreeMap<Role, f6
     out
 }
 
-/// Ankle joint height when the foot is flat: the 5th percentile of the ankles' height above
-/// `ground` over the clip (a walk's flat-foot frames), within 2–15 cm.
+/// Ankle joint height when the foot is flat: [`flat_height`] of the ankles, within 2–15 cm
+/// (the canonical human's without ankles).
 fn ankle_height(motion: &HumanMotion, feet: [Option<usize>; 2], ground: f64) -> f64 {
-    let mut z: Vec<f64> = feet
+    flat_height(motion, feet, ground).map_or(0.039 * CANONICAL_HEIGHT, |z| z.clamp(0.02, 0.15))
+}
+
+/// Height of joints above `ground` when they are as low as they go: the 5th percentile of
+/// `bodies`' heights over the clip (a walk's flat-foot frames). `None` without such bodies.
+fn flat_height(motion: &HumanMotion, bodies: [Option<usize>; 2], ground: f64) -> Option<f64> {
+    let mut z: Vec<f64> = bodies
         .iter()
         .flatten()
         .flat_map(|&b| (0..motion.num_frames).map(move |f| (b, f)))
         .map(|(b, f)| motion.position(f, b).z - ground)
         .filter(|v| v.is_finite())
         .collect();
-    if z.is_empty() {
-        return 0.039 * CANONICAL_HEIGHT;
-    }
     z.sort_by(f64::total_cmp);
-    z[(z.len() - 1) / 20].clamp(0.02, 0.15)
+    z.get(z.len().checked_sub(1)? / 20).copied()
 }
 
 /// The chains of the canonical pose: each role with the roles its segment may start from, in
@@ -463,11 +439,9 @@ fn segments(
     frames: &BTreeMap<Role, UnitQuaternion<f64>>,
 ) -> BTreeMap<Role, (Option<Role>, Vector3<f64>)> {
     let mut out = BTreeMap::new();
-    let (Some(l), Some(r), Some(pelvis)) = (
-        points.get(&Role::LeftThigh),
-        points.get(&Role::RightThigh),
-        frames.get(&Role::Pelvis),
-    ) else {
+    let (Some(l), Some(r), Some(pelvis)) =
+        (points.get(&Role::LeftThigh), points.get(&Role::RightThigh), frames.get(&Role::Pelvis))
+    else {
         return out;
     };
     let mid = (l + r) / 2.0;
@@ -538,7 +512,11 @@ fn limb_frames(
     for side in [Side::Left, Side::Right] {
         let limbs: [([Part; 3], &[Part], f64); 2] = [
             ([Part::Thigh, Part::Shin, Part::Foot], &[Part::Thigh, Part::Shin], 1.0),
-            ([Part::UpperArm, Part::Forearm, Part::Hand], &[Part::UpperArm, Part::Forearm, Part::Hand], -1.0),
+            (
+                [Part::UpperArm, Part::Forearm, Part::Hand],
+                &[Part::UpperArm, Part::Forearm, Part::Hand],
+                -1.0,
+            ),
         ];
         for (limb, twisted, y_sign) in limbs {
             let limb = limb.map(|p| Role::of(p, side));
@@ -586,6 +564,60 @@ impl MiddleHinge {
     }
 }
 
+/// A collision primitive of a foot: its kind and size, its centre seen from the foot body's
+/// origin and its orientation, both in the foot role's canonical frame at `qpos0`.
+#[derive(Debug, Clone, Copy)]
+struct SoleGeom {
+    kind: mjcf::GeomType,
+    size: [f64; 3],
+    pos: Vector3<f64>,
+    rot: UnitQuaternion<f64>,
+}
+
+/// The soles' primitives ([`RobotRoles::soles`]) per foot role, in the foot's canonical frame.
+fn sole_geoms(
+    model: &Model,
+    data: &Data,
+    roles: &RobotRoles,
+    frames: &BTreeMap<Role, UnitQuaternion<f64>>,
+) -> BTreeMap<Role, Vec<SoleGeom>> {
+    let mut out = BTreeMap::new();
+    for (side, sole) in [Side::Left, Side::Right].into_iter().zip(roles.soles()) {
+        let role = Role::of(Part::Foot, side);
+        let Some(c) = frames.get(&role) else { continue };
+        let geoms = sole
+            .geoms
+            .iter()
+            .filter_map(|&g| {
+                let geom = model.geoms.get(g)?;
+                let r = nalgebra::Rotation3::from_matrix_unchecked(*data.geom_xmat.get(g)?);
+                Some(SoleGeom {
+                    kind: geom.kind,
+                    size: geom.size,
+                    pos: c.inverse() * (data.geom_xpos.get(g)? - data.xpos.get(sole.body)?),
+                    rot: c.inverse() * UnitQuaternion::from_rotation_matrix(&r),
+                })
+            })
+            .collect::<Vec<_>>();
+        if !geoms.is_empty() {
+            out.insert(role, geoms);
+        }
+    }
+    out
+}
+
+/// Height of the sole's lowest point above the foot body's origin when the foot's canonical
+/// frame is `frame` (world).
+fn sole_low(geoms: &[SoleGeom], frame: &UnitQuaternion<f64>) -> f64 {
+    geoms
+        .iter()
+        .map(|g| {
+            let r = (frame * g.rot).to_rotation_matrix().into_inner();
+            (frame * g.pos).z + crate::constraints::support_offset(g.kind, &g.size, &r).z
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The robot's half: per role, body, `C_r⁻¹ ⊗ q_body`, body offset from the role point (in the
 /// body frame), and path lengths like [`HumanBody::paths`].
 struct RobotSide {
@@ -599,6 +631,8 @@ struct RobotSide {
     hinges: BTreeMap<Role, MiddleHinge>,
     /// The canonical frames used ([`limb_frames`]).
     frames: BTreeMap<Role, UnitQuaternion<f64>>,
+    /// Per foot role, its sole's primitives ([`sole_geoms`]).
+    soles: BTreeMap<Role, Vec<SoleGeom>>,
 }
 
 fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
@@ -635,6 +669,7 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
         segments: segments(&points, &frames),
         origins,
         hinges,
+        soles: sole_geoms(model, &data, roles, &frames),
         frames,
     }
 }
@@ -673,8 +708,70 @@ fn fitted_offset(
             count += 1;
         }
     }
-    (count > 0).then(|| relative.inverse() * (sum / count as f64))
+    if count == 0 {
+        return None;
+    }
+    let mut fit = sum / count as f64;
+    if let (true, Some(geoms)) = (role.part() == Part::Foot, robot.soles.get(&role)) {
+        fit = sole_fit(geoms, human, role, root_scale, scale, fit).unwrap_or(fit);
+    }
+    Some(relative.inverse() * fit)
 }
+
+/// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor
+/// wherever the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the
+/// ball), with the foot turned as the human's: least squares over those postures of the
+/// sole's lowest point's height, `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
+/// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale`
+/// about the root). Flat postures fix the height; the postures on the heel or the ball fix
+/// how far forward the body sits (a robot sole longer than the scaled human foot is moved
+/// back, so that its toe does not dig in when the human rolls onto the ball). The horizontal
+/// offset stays near `prior` (the copy fit) where the postures do not decide it: a shift
+/// costs as much as the same height error in [`SOLE_PRIOR`] of the postures.
+fn sole_fit(
+    geoms: &[SoleGeom],
+    human: &HumanBody,
+    role: Role,
+    root_scale: f64,
+    scale: f64,
+    prior: Vector3<f64>,
+) -> Option<Vector3<f64>> {
+    let k = usize::from(role.side() == Some(Side::Right));
+    let mut normal = nalgebra::Matrix3::zeros();
+    let mut rhs = Vector3::zeros();
+    let mut n = 0usize;
+    for posture in human.postures.iter().filter(|p| p.feet_down.get(k) == Some(&true)) {
+        let (Some(pelvis), Some(ankle), Some(frame)) = (
+            posture.points.get(&Role::Pelvis),
+            posture.points.get(&role),
+            posture.frames.get(&role),
+        ) else {
+            continue;
+        };
+        let a = root_scale * pelvis.z + (ankle.z - pelvis.z) * scale;
+        let low = sole_low(geoms, frame);
+        let r = frame.inverse() * Vector3::z();
+        if !(a + low).is_finite() {
+            continue;
+        }
+        normal += r * r.transpose();
+        rhs -= r * (a + low);
+        n += 1;
+    }
+    if n == 0 {
+        return None;
+    }
+    let w = SOLE_PRIOR * n as f64;
+    normal[(0, 0)] += w;
+    normal[(1, 1)] += w;
+    rhs.x += w * prior.x;
+    rhs.y += w * prior.y;
+    let fit = normal.try_inverse()? * rhs;
+    fit.iter().all(|v| v.is_finite()).then_some(fit)
+}
+
+/// Weight of the copy fit's horizontal foot offset in [`sole_fit`], as a share of the postures.
+const SOLE_PRIOR: f64 = 0.001;
 
 /// One posture's `C_h⁻¹ (x_robot − p_target)` for [`fitted_offset`].
 fn copy_error(
@@ -704,7 +801,7 @@ fn copy_error(
         };
         at.insert(r, start + turn * v);
         let frame = match (robot.hinges.get(&r), from) {
-            (Some(h), Some(_)) if std::env::var("NOCLAMP").is_err() => turn * h.clamp(turn.inverse() * c),
+            (Some(h), Some(_)) => turn * h.clamp(turn.inverse() * c),
             _ => *c,
         };
         frames.insert(r, frame);
@@ -824,7 +921,8 @@ pub fn bind(
         let scale = scale_of(&e.human_body)?;
         // The offset fitted to the canonical human is replaced by the one fitted to this
         // human; what the file adds to it (an edit) is kept.
-        let origin = match (model.body_id(&e.robot_body), roles.roles.get(&role), frames.get(&role)) {
+        let origin = match (model.body_id(&e.robot_body), roles.roles.get(&role), frames.get(&role))
+        {
             (Some(b), Some(r), Some(c)) => Some(c.inverse() * (data.xpos[b] - r.point)),
             _ => None,
         };
@@ -1139,6 +1237,44 @@ mod tests {
         assert!((human.paths[&Role::LeftFoot] - (0.245 + 0.246) * h).abs() < 1e-12);
         assert!((human.paths[&Role::LeftThigh] - 0.05 * h).abs() < 1e-12);
         assert!((human.paths[&Role::Pelvis] - (0.245 + 0.246 + 0.039) * h).abs() < 1e-12);
+    }
+
+    /// A human foot that stands flat, then rolls onto its ball (a pivot `l` ahead of the
+    /// ankle and `h` below it): the robot's sole (a box reaching past the pivot) must end
+    /// up with its front bottom edge at the pivot, which is on the floor in every posture.
+    #[test]
+    fn the_sole_fit_puts_the_sole_on_the_floor_when_the_foot_rolls_onto_its_ball() {
+        let (l, h) = (0.09, 0.07);
+        let sole = SoleGeom {
+            kind: mjcf::GeomType::Box,
+            size: [0.1, 0.04, 0.01],
+            pos: Vector3::new(0.03, 0.0, -0.03),
+            rot: UnitQuaternion::identity(),
+        };
+        let mut human = HumanBody::canonical();
+        human.postures = [0.0f64, 5.0, 10.0, 20.0, 30.0, 40.0]
+            .iter()
+            .map(|deg| {
+                // Toe down: a turn about +y; the ankle rises about the pivot on the floor.
+                let q = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), deg.to_radians());
+                let ankle = Vector3::new(0.0, 0.1, 0.0) - q * Vector3::new(l, 0.0, -h);
+                let points = [(Role::Pelvis, Vector3::new(0.0, 0.0, 0.9)), (Role::LeftFoot, ankle)]
+                    .into_iter()
+                    .collect();
+                let frames = [(Role::LeftFoot, q)].into_iter().collect();
+                Posture { points, frames, feet_down: [true, false] }
+            })
+            .collect();
+        let prior = Vector3::new(0.05, 0.01, 0.0);
+        let fit = sole_fit(&[sole], &human, Role::LeftFoot, 1.0, 1.0, prior).unwrap();
+        // Body origin + front bottom edge (0.13, ·, −0.04) = pivot (l, ·, −h) from the ankle
+        // (to a few mm: the prior, 9 cm off, still pulls a little).
+        assert!((fit.x - (l - 0.13)).abs() < 3e-3, "{fit:?}");
+        assert!((fit.z - (-h + 0.04)).abs() < 1e-3, "{fit:?}");
+        // Tilts say nothing about the sideways offset: the prior's.
+        assert!((fit.y - prior.y).abs() < 1e-9, "{fit:?}");
+        // The right foot never touches: no fit.
+        assert!(sole_fit(&[sole], &human, Role::RightFoot, 1.0, 1.0, prior).is_none());
     }
 
     #[test]
