@@ -26,6 +26,12 @@ pub struct FkArgs {
     /// Subject height in metres instead of the estimate.
     #[arg(long)]
     pub height: Option<f64>,
+    /// Also write every frame to this `.npz`: `fps`, `body_names`, `body_pos_w` (T×B×3, m,
+    /// Z up), `body_quat_w` (T×B×4, w x y z), `ground`, `height`, and the recognised roles:
+    /// `role_names`, `role_bodies` (the joint playing each), `role_frame_offsets` (R×4: a
+    /// role's canonical body frame is its joint's `body_quat_w` ⊗ this offset).
+    #[arg(long, value_name = "OUT.npz")]
+    pub npz: Option<PathBuf>,
 }
 
 /// `--axes` values (see `fk::AxisConvention`).
@@ -75,7 +81,49 @@ fn parse_units(text: &str) -> Result<UnitChoice, String> {
 
 /// `retarget bvh fk`, from parsed arguments.
 pub fn run(args: &FkArgs) -> anyhow::Result<ExitCode> {
+    if let Some(out) = &args.npz {
+        let bvh = crate::cmd_bvh::read_bvh(&args.file)?;
+        write_npz(&bvh, &args.options(), out).with_context(|| args.file.display().to_string())?;
+    }
     print_fk(&args.file, args.frame, &args.options())
+}
+
+/// The whole clip's FK and roles as an `.npz` (see [`FkArgs::npz`]).
+pub fn write_npz(bvh: &bvh::Bvh, options: &FkOptions, out: &Path) -> anyhow::Result<()> {
+    use retarget::writers::npy::Array;
+    let (motion, report) = fk::human_motion(bvh, options)?;
+    let (t, b) = (motion.num_frames, motion.body_names.len());
+    let mut pos = Vec::with_capacity(t * b * 3);
+    let mut quat = Vec::with_capacity(t * b * 4);
+    for f in 0..t {
+        for body in 0..b {
+            let (p, q) = (motion.position(f, body), motion.orientation(f, body));
+            pos.extend([p.x, p.y, p.z]);
+            quat.extend([q.w, q.i, q.j, q.k]);
+        }
+    }
+    let (mut names, mut bodies, mut offsets) = (Vec::new(), Vec::new(), Vec::new());
+    if let Ok(humanoid) = &report.humanoid {
+        for (role, joint) in humanoid.roles.iter() {
+            let q = humanoid.frame_offsets.get(&role).copied().unwrap_or_default();
+            names.push(role.name().to_owned());
+            bodies.push(joint.name.clone());
+            offsets.extend([q.w, q.i, q.j, q.k]);
+        }
+    }
+    let arrays = [
+        ("fps", Array::f64(vec![1], vec![motion.fps])),
+        ("body_names", Array::strings(&motion.body_names)),
+        ("body_pos_w", Array::f64(vec![t, b, 3], pos)),
+        ("body_quat_w", Array::f64(vec![t, b, 4], quat)),
+        ("ground", Array::f64(vec![1], vec![report.ground])),
+        ("height", Array::f64(vec![1], vec![report.height])),
+        ("role_names", Array::strings(&names)),
+        ("role_bodies", Array::strings(&bodies)),
+        ("role_frame_offsets", Array::f64(vec![names.len(), 4], offsets)),
+    ];
+    retarget::writers::write_npz(out, &arrays)?;
+    Ok(())
 }
 
 /// Print every body's world pose at `frame`, then the [`FkReport`].
@@ -264,6 +312,34 @@ Frame Time: 0.033333
             .to_string()
             .contains("2 frames"));
         assert_eq!(report_lines(&bvh).unwrap().len(), 3);
+    }
+
+    /// `--npz`: every frame's poses, as `frame_poses` gives them one frame at a time.
+    #[test]
+    fn npz_holds_every_frame() {
+        use retarget::writers::npy::{decode, ArrayData};
+        use std::io::Read as _;
+        let bvh = bvh::from_str(TINY).unwrap();
+        let path = std::env::temp_dir().join(format!("fk-npz-{}.npz", std::process::id()));
+        write_npz(&bvh, &FkOptions::default(), &path).unwrap();
+        let mut zip = zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
+        let mut array = |name: &str| {
+            let mut bytes = Vec::new();
+            zip.by_name(&format!("{name}.npy")).unwrap().read_to_end(&mut bytes).unwrap();
+            decode(&bytes).unwrap()
+        };
+        let pos = array("body_pos_w");
+        assert_eq!(pos.shape, [2, 6, 3]);
+        assert_eq!(array("body_quat_w").shape, [2, 6, 4]);
+        // Not a humanoid (no arms): no roles, but the arrays are there.
+        assert_eq!(array("role_frame_offsets").shape, [0, 4]);
+        let ArrayData::F64(pos) = pos.data else { panic!("float64 expected") };
+        let poses = frame_poses(&bvh, 1, &FkOptions::default()).unwrap();
+        for (b, body) in poses.bodies.iter().enumerate() {
+            let at = &pos[(6 + b) * 3..(6 + b) * 3 + 3];
+            assert!(at.iter().zip(body.position).all(|(a, e)| (a - e).abs() < 1e-12));
+        }
+        std::fs::remove_file(&path).unwrap();
     }
 
     #[test]

@@ -16,6 +16,11 @@ pub enum RobotCommand {
     Info {
         /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
         robot: String,
+        /// Also write the roles as JSON: per role its body, role point and `frame_offset`
+        /// (w x y z: the role's canonical frame is the body's world orientation ⊗ it), the
+        /// sole bodies, the forward direction and the height, all at `qpos0`.
+        #[arg(long, value_name = "OUT.json")]
+        json: Option<std::path::PathBuf>,
     },
     /// Write the IK config derived for a robot (GMR schema): against the canonical human,
     /// with role names as human joints (bound to each skeleton when used with --config), or
@@ -73,7 +78,7 @@ pub fn list() -> anyhow::Result<ExitCode> {
 
 pub fn run(cmd: RobotCommand) -> anyhow::Result<ExitCode> {
     match cmd {
-        RobotCommand::Info { robot } => info(&robot),
+        RobotCommand::Info { robot, json } => info(&robot, json.as_deref()),
         RobotCommand::Init { robot, bvh, output } => init(&robot, bvh.as_deref(), &output),
         RobotCommand::Check { robot, configs, seed, tolerance } => {
             check(&robot, configs, seed, tolerance)
@@ -81,8 +86,13 @@ pub fn run(cmd: RobotCommand) -> anyhow::Result<ExitCode> {
     }
 }
 
-fn info(robot: &str) -> anyhow::Result<ExitCode> {
+fn info(robot: &str, json: Option<&std::path::Path>) -> anyhow::Result<ExitCode> {
     let model = shipped::robot_model(robot)?;
+    if let Some(path) = json {
+        let roles = retarget::RobotRoles::recognise(&model)?;
+        let text = serde_json::to_string_pretty(&roles_json(&model, &roles))?;
+        crate::atomic_write(path, format!("{text}\n").as_bytes())?;
+    }
     let mut out = String::new();
     writeln!(out, "robot: {robot}")?;
     writeln!(
@@ -134,6 +144,33 @@ fn info(robot: &str) -> anyhow::Result<ExitCode> {
     }
     emit(&out)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The roles of `robot info --json` (see [`RobotCommand::Info`]).
+fn roles_json(model: &Model, roles: &retarget::RobotRoles) -> serde_json::Value {
+    use serde_json::{json, Map, Value};
+    let mut data = mjcf::Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
+    let frames = roles.canonical_frames();
+    let mut out = Map::new();
+    for (role, r) in &roles.roles {
+        let mut entry = Map::new();
+        entry.insert("body".into(), Value::from(r.name.clone()));
+        entry.insert("point".into(), json!([r.point.x, r.point.y, r.point.z]));
+        if let (Some(c), Some(q)) = (frames.get(role), data.xquat.get(r.body)) {
+            let o = q.inverse() * c;
+            entry.insert("frame_offset".into(), json!([o.w, o.i, o.j, o.k]));
+        }
+        out.insert(role.name().to_owned(), Value::Object(entry));
+    }
+    let body = |b: usize| model.bodies.get(b).map_or("", |b| b.name.as_str()).to_owned();
+    json!({
+        "base": body(roles.base),
+        "forward": [roles.forward.x, roles.forward.y, roles.forward.z],
+        "height": roles.height,
+        "roles": out,
+        "soles": { "left": body(roles.soles[0].body), "right": body(roles.soles[1].body) },
+    })
 }
 
 /// `retarget robot init ROBOT [--bvh FILE] -o OUT.json`.
@@ -191,4 +228,27 @@ fn check(robot: &str, configs: usize, seed: u64, tolerance: f64) -> anyhow::Resu
 #[cfg(not(feature = "mujoco"))]
 fn check(robot: &str, _configs: usize, _seed: u64, _tolerance: f64) -> anyhow::Result<ExitCode> {
     anyhow::bail!("{robot}: `retarget robot check` needs a build with the `mujoco` feature (cargo build -p cli --features mujoco, after scripts/fetch-mujoco)")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `robot info --json`: the roles with their bodies, and frame offsets that turn the
+    /// bodies' orientations at `qpos0` into the canonical frames (upright, facing +x).
+    #[test]
+    fn roles_json_of_the_g1() {
+        let model = shipped::robot_model("unitree_g1").unwrap();
+        let roles = retarget::RobotRoles::recognise(&model).unwrap();
+        let json = roles_json(&model, &roles);
+        assert_eq!(json["roles"]["pelvis"]["body"], "pelvis");
+        assert_eq!(json["roles"]["left_foot"]["body"], "left_ankle_roll_link");
+        assert_eq!(json["soles"]["right"], "right_ankle_roll_link");
+        assert!((json["forward"][0].as_f64().unwrap() - 1.0).abs() < 1e-9);
+        // The G1's pelvis and torso frames are the canonical ones at qpos0.
+        for role in ["pelvis", "chest"] {
+            let w = json["roles"][role]["frame_offset"][0].as_f64().unwrap();
+            assert!((w.abs() - 1.0).abs() < 1e-6, "{role}: {json}");
+        }
+    }
 }

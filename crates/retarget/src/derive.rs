@@ -867,7 +867,7 @@ pub fn derive(
             .unwrap_or(*offset);
         rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale });
     }
-    let text = config_json(&rows, human.height);
+    let text = config_json(&rows, human.height, robot.bodies.contains_key(&Role::Chest));
     IkConfig::from_json_str(&text, source)
 }
 
@@ -1005,7 +1005,21 @@ pub fn largest_offset_difference(a: &IkConfig, b: &IkConfig) -> Option<f64> {
     worst
 }
 
-fn config_json(rows: &[Row], height: f64) -> String {
+/// The weights of `part` ([`WEIGHTS`]). A robot without a chest role (its arms hang from the
+/// pelvis body: no waist) tracks its pelvis with the larger of the pelvis's and the chest's
+/// weights: that body is its chest too, and with the pelvis's rotation weight (10) against
+/// the upper arms' (100) arms that cannot reach their targets tilt the whole robot.
+fn weights(part: Part, robot_has_chest: bool) -> [f64; 4] {
+    let of = |p: Part| WEIGHTS.iter().find(|(q, _)| *q == p).map_or([0.0; 4], |w| w.1);
+    let own = of(part);
+    if part != Part::Pelvis || robot_has_chest {
+        return own;
+    }
+    let chest = of(Part::Chest);
+    [0, 1, 2, 3].map(|k| own[k].max(chest[k]))
+}
+
+fn config_json(rows: &[Row], height: f64, robot_has_chest: bool) -> String {
     let joints: BTreeMap<Role, String> = rows.iter().map(|r| (r.role, r.joint.clone())).collect();
     let mut text = String::new();
     let pelvis = rows.iter().find(|r| r.role == Role::Pelvis);
@@ -1026,7 +1040,7 @@ fn config_json(rows: &[Row], height: f64) -> String {
         let entries: Vec<TableRow> = rows
             .iter()
             .map(|r| {
-                let w = WEIGHTS.iter().find(|(p, _)| *p == r.role.part()).map_or([0.0; 4], |w| w.1);
+                let w = weights(r.role.part(), robot_has_chest);
                 (r.body.clone(), r.joint.clone(), w[*table], w[table + 1], r.pos, r.rot)
             })
             .collect();

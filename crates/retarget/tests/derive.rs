@@ -69,3 +69,47 @@ fn binding_a_role_named_config_equals_deriving_for_the_skeleton() {
         }
     }
 }
+
+/// The feet are fitted so that the sole is on the floor when the human rolls onto the ball
+/// of the foot: the G1's sole reaches farther ahead of its ankle than the scaled human foot,
+/// so its ankle target sits behind the human's (foot frame x, the G1's foot body frame at
+/// `qpos0` being the canonical one), and a few millimetres above the flat-foot height.
+#[test]
+fn a_sole_longer_than_the_scaled_foot_is_moved_back() {
+    let Some(bvh) = lafan_walk() else { return };
+    let human = derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
+    let (model, _) = shipped("unitree_g1");
+    let roles = RobotRoles::recognise(&model).unwrap();
+    let config = derive::derive(&model, &roles, &human, "g1").unwrap();
+    for foot in ["left_ankle_roll_link", "right_ankle_roll_link"] {
+        let e = config.ik_match_table1.iter().find(|e| e.robot_body == foot).unwrap();
+        assert!(e.pos_offset.x < -0.003, "{foot}: {:?}", e.pos_offset);
+        assert!(e.pos_offset.z.abs() < 0.02, "{foot}: {:?}", e.pos_offset);
+    }
+}
+
+/// A robot whose arms hang from its pelvis body (no waist: Berkeley Humanoid Lite) has no
+/// chest role; its pelvis is tracked with the chest's rotation weight, so that arms which
+/// cannot reach their targets do not tilt it. With a chest (the G1) the pelvis keeps GMR's.
+#[test]
+fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
+    let Some(bvh) = lafan_walk() else { return };
+    let Some(path) = shared::shared_file("reference/robots/berkeley_humanoid_lite/bhl_scene.xml")
+    else {
+        return;
+    };
+    let human = derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
+    let pelvis_weights = |model: &mjcf::Model, chest: bool| {
+        let roles = RobotRoles::recognise(model).unwrap();
+        assert_eq!(roles.roles.contains_key(&fk::Role::Chest), chest);
+        let config = derive::derive(model, &roles, &human, "c").unwrap();
+        let root = &config.robot_root_name;
+        let rot = |t: &[retarget::MatchEntry]| {
+            t.iter().find(|e| &e.robot_body == root).unwrap().rot_weight
+        };
+        (rot(&config.ik_match_table1), rot(&config.ik_match_table2))
+    };
+    let bhl = mjcf::Model::from_path(&path).unwrap();
+    assert_eq!(pelvis_weights(&bhl, false), (100.0, 10.0));
+    assert_eq!(pelvis_weights(&shipped("unitree_g1").0, true), (10.0, 5.0));
+}

@@ -132,6 +132,13 @@ pub fn write_motion(
     }
 }
 
+/// Writes `arrays` (name, array, in file order) as an `.npz` in numpy's `savez_compressed`
+/// layout, atomically ([`write_atomically`]): for arrays other than a robot motion's (the
+/// CLI's export of a human motion).
+pub fn write_npz(path: &Path, arrays: &[(&str, npy::Array)]) -> Result<(), Error> {
+    write_atomically(path, |w| npz::write_npz(w, arrays))
+}
+
 /// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
 /// `root_rot` use it. The only place where our files change quaternion order.
 #[must_use]
