@@ -164,6 +164,8 @@ fn robot_scene(args: &ViewArgs) -> anyhow::Result<Scene> {
     }
     let label = file_name(Path::new(robot));
     let figure = sources::robot_figure(&model, &motion.qpos[..frames * motion.nq], &label)?;
+    let plots =
+        motion.contacts.as_ref().map_or_else(Vec::new, |c| sources::contact_plots(c, frames));
     Ok(Scene {
         title: file_name(path),
         fps: motion.fps,
@@ -172,6 +174,6 @@ fn robot_scene(args: &ViewArgs) -> anyhow::Result<Scene> {
         tree: None,
         skeletons,
         robot: Some(figure),
-        plots: vec![],
+        plots,
     })
 }

@@ -435,7 +435,7 @@
     return phases;
   }
   function buildPlots() {
-    if (scene.plots.length) { heading('Quality'); scene.plots.forEach((p) => addPlot(decoded(p), true)); }
+    if (scene.plots.length) { heading('From the motion file'); scene.plots.forEach((p) => addPlot(decoded(p), true)); }
     const targets = figures.find((f) => f.targets);
     if (robot && targets) {
       const pairs = targets.names.map((name, i) => [name, i, robot.names.indexOf(name)]).filter((p) => p[2] >= 0);

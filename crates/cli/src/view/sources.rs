@@ -1,7 +1,8 @@
 //! The project's data types → the page's plain data ([`super::Scene`] parts).
 
 use super::{
-    JointKind, PointFigure, PointStyle, RobotBody, RobotFigure, RobotGeom, RobotJoint, Shape,
+    JointKind, Plot, PointFigure, PointStyle, RobotBody, RobotFigure, RobotGeom, RobotJoint,
+    Series, Shape,
 };
 use anyhow::{ensure, Context};
 
@@ -98,9 +99,55 @@ pub fn robot_figure(model: &mjcf::Model, qpos: &[f64], label: &str) -> anyhow::R
         nq,
         qpos0: model.qpos0.clone(),
         qpos: qpos32,
-        feet: super::find_feet(&names),
+        feet: robot_feet(model, &names),
         check,
     })
+}
+
+/// The robot's feet for the page's foot plots: the soles the robot recogniser finds
+/// (`retarget robot info`), else the bodies named like feet. Indices count from the first
+/// body after the world, as the page's bodies do.
+fn robot_feet(model: &mjcf::Model, names: &[String]) -> Vec<(String, usize)> {
+    match retarget::RobotRoles::recognise(model) {
+        Ok(roles) => ["left", "right"]
+            .into_iter()
+            .zip(roles.soles())
+            .filter_map(|(side, sole)| Some((side.to_owned(), sole.body.checked_sub(1)?)))
+            .collect(),
+        Err(_) => super::find_feet(names),
+    }
+}
+
+/// The source's foot contact phases (npz `contact_left`, `contact_right`), one plot per foot:
+/// 1 in contact, 0 not, the phases shaded.
+pub fn contact_plots(contacts: &retarget::FootContacts, frames: usize) -> Vec<Plot> {
+    [("left", &contacts.left), ("right", &contacts.right)]
+        .into_iter()
+        .map(|(side, on)| {
+            let on = &on[..frames.min(on.len())];
+            let mut shaded = Vec::new();
+            let mut start = None;
+            for (f, &c) in on.iter().chain([&false]).enumerate() {
+                match (c, start) {
+                    (true, None) => start = Some(f),
+                    (false, Some(s)) => {
+                        shaded.push([s, f]);
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+            let mut values: Vec<f32> = on.iter().map(|&c| if c { 1.0 } else { 0.0 }).collect();
+            values.resize(frames, 0.0);
+            Plot {
+                title: format!("{side} foot: source contact (npz contact_{side}), phases shaded"),
+                unit: String::new(),
+                series: vec![Series { name: format!("contact_{side}"), values }],
+                limits: None,
+                shaded,
+            }
+        })
+        .collect()
 }
 
 /// Check that a robot motion belongs to `model`: same `nq` and, when the motion names its
@@ -186,4 +233,38 @@ pub fn skeleton_figure(
 #[allow(dead_code)]
 pub fn model_from_xml(xml: &str) -> anyhow::Result<mjcf::Model> {
     mjcf::Model::from_xml_str(xml, None).context("robot model")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn contact_plots_shade_the_phases() {
+        let contacts = retarget::FootContacts {
+            left: vec![true, true, false, false, true],
+            right: vec![false, true, true, true, false],
+        };
+        let plots = contact_plots(&contacts, 5);
+        assert_eq!(plots.len(), 2);
+        assert_eq!(plots[0].shaded, vec![[0, 2], [4, 5]]);
+        assert_eq!(plots[1].shaded, vec![[1, 4]]);
+        assert_eq!(plots[1].series[0].values, vec![0.0, 1.0, 1.0, 1.0, 0.0]);
+        // A page cut to fewer frames (the source is shorter) cuts the plots too.
+        let cut = contact_plots(&contacts, 3);
+        assert_eq!(cut[1].shaded, vec![[1, 3]]);
+        assert_eq!(cut[0].series[0].values.len(), 3);
+    }
+
+    /// The feet of the foot plots come from the robot recogniser: ToddlerBot's feet have no
+    /// foot-like names (`ank_roll_link`, `ank_roll_link_2`).
+    #[test]
+    fn robot_feet_from_the_recogniser() {
+        let model = crate::shipped::robot_model("stanford_toddy").unwrap();
+        let names: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+        let feet = robot_feet(&model, &names);
+        let named: Vec<(&str, &str)> =
+            feet.iter().map(|(side, i)| (side.as_str(), names[*i].as_str())).collect();
+        assert_eq!(named, [("left", "ank_roll_link"), ("right", "ank_roll_link_2")]);
+    }
 }
