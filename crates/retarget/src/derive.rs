@@ -139,7 +139,7 @@ pub struct Posture {
     pub points: BTreeMap<Role, Vector3<f64>>,
     pub frames: BTreeMap<Role, UnitQuaternion<f64>>,
     /// `[left, right]`: whether the foot touches the floor (its ankle or its toe joint within
-    /// [`FLAT_FOOT`] of the height it has when the foot is flat): flat, on the heel or on the
+    /// 3 cm of the height it has when the foot is flat): flat, on the heel or on the
     /// ball of the foot.
     pub feet_down: [bool; 2],
 }
