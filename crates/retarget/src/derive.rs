@@ -320,7 +320,7 @@ fn ankle_height(motion: &HumanMotion, feet: [Option<usize>; 2], ground: f64) -> 
         return 0.039 * CANONICAL_HEIGHT;
     }
     z.sort_by(f64::total_cmp);
-    z[(z.len() - 1) / 20].clamp(0.02, 0.15)
+    z.get(z.len().saturating_sub(1) / 20).map_or(0.039 * CANONICAL_HEIGHT, |h| h.clamp(0.02, 0.15))
 }
 
 /// The robot's half: per role, body, `C_r⁻¹ ⊗ q_body`, body offset from the role point (in the
@@ -336,9 +336,12 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
     let frames = roles.canonical_frames();
     let mut bodies = BTreeMap::new();
     for (role, r) in &roles.roles {
-        let Some(c) = frames.get(role) else { continue };
-        let q = data.xquat[r.body];
-        let offset = q.inverse() * (data.xpos[r.body] - r.point);
+        let (Some(c), Some(q), Some(x)) =
+            (frames.get(role), data.xquat.get(r.body), data.xpos.get(r.body))
+        else {
+            continue;
+        };
+        let offset = q.inverse() * (x - r.point);
         bodies.insert(*role, (r.name.clone(), c.inverse() * q, offset));
     }
     let points: BTreeMap<Role, Vector3<f64>> =
@@ -539,7 +542,8 @@ fn config_json(rows: &[Row], height: f64) -> String {
             .iter()
             .map(|r| {
                 let w = WEIGHTS.iter().find(|(p, _)| *p == r.role.part()).map_or([0.0; 4], |w| w.1);
-                (r.body.clone(), r.joint.clone(), w[*table], w[table + 1], r.pos, r.rot)
+                let weight = |k: usize| w.get(k).copied().unwrap_or(0.0);
+                (r.body.clone(), r.joint.clone(), weight(*table), weight(table + 1), r.pos, r.rot)
             })
             .collect();
         write_table(&mut text, k + 1, &entries, k == 1);

@@ -18,6 +18,11 @@
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact
+// labels' lengths, which `plan` clips to it; body and geom ids come from the model.
+#![allow(clippy::indexing_slicing)]
+
 use mjcf::{Data, GeomType, Model};
 use std::ops::Range;
 

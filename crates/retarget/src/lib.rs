@@ -1,6 +1,10 @@
 //! Retargeting: GMR-schema IK configs, per-frame targets, the damped-least-squares solver,
 //! the resulting robot motion, its writers and quality metrics.
 
+// Library code never panics on input (issue 15): the compiler checks it. Tests may (clippy.toml).
+// Numeric modules allow indexing with the reason in their header.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 pub mod chunked;
 pub mod config;
 pub mod constraints;

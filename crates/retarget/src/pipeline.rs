@@ -1,5 +1,11 @@
 //! BVH → robot motion: human FK, targets, IK over every frame with warm start.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built here),
+// body ids come from the model; the human motion's sizes are checked by `HumanMotion::validate`
+// first.
+#![allow(clippy::indexing_slicing)]
+
 use std::ops::Range;
 use std::time::Instant;
 
@@ -391,7 +397,7 @@ impl<'a> Prepared<'a> {
         // the self-collision rows: 1402 frames > 1 cm against 14.)
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
-            frames.push(solver.solve_frame(self.frame_targets(f), dt));
+            frames.push(solver.solve_frame(self.frame_targets(f), dt)?);
             if solver.qpos().iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     frame: f,
@@ -409,7 +415,7 @@ impl<'a> Prepared<'a> {
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
-                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f));
+                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
                 }
             }

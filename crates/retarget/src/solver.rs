@@ -17,6 +17,12 @@
 //! most `max_extra_steps` more. The first frame starts from `qpos0`, every later one from
 //! the previous solution.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: buffers are sized from the model (`nq`, `nv`, bodies) in `Solver::new`, which checks
+// the task bodies; `solve_frame`/`errors` check the target slots; the model's own ids (parents,
+// dof and qpos addresses) are in range by `mjcf::Model`'s construction.
+#![allow(clippy::indexing_slicing)]
+
 use mjcf::{Data, JointType, Model};
 
 use crate::constraints::{Constraint, StepContext};
@@ -325,7 +331,12 @@ impl<'m> Solver<'m> {
 
     /// Solves one frame from the current configuration. `targets` are indexed by the task
     /// specs' `target`; `dt` (seconds per frame) is used by `max_joint_speed` only.
-    pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> FrameDiagnostics {
+    ///
+    /// # Errors
+    /// [`Error::InvalidOption`] when `targets` is shorter than the task specs' largest
+    /// `target` slot.
+    pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> Result<FrameDiagnostics, Error> {
+        self.check_targets(targets)?;
         self.previous.copy_from_slice(&self.qpos);
         self.qp_failures = 0;
         self.relaxed_steps = 0;
@@ -337,7 +348,7 @@ impl<'m> Solver<'m> {
             error = e;
         }
         let (pos_error, rot_error) = self.tracking_errors(targets);
-        FrameDiagnostics {
+        Ok(FrameDiagnostics {
             steps,
             error,
             pos_error,
@@ -345,7 +356,7 @@ impl<'m> Solver<'m> {
             at_limit: self.at_limit(),
             qp_failures: self.qp_failures,
             relaxed_steps: self.relaxed_steps,
-        }
+        })
     }
 
     fn solve_stage(&mut self, s: usize, targets: &[Pose], dt: f64) -> (usize, f64) {
@@ -628,9 +639,24 @@ impl<'m> Solver<'m> {
     }
 
     /// Tracking errors at the current configuration (as in [`FrameDiagnostics`]).
-    #[must_use]
-    pub fn errors(&self, targets: &[Pose]) -> (Vec<f64>, Vec<f64>) {
-        self.tracking_errors(targets)
+    ///
+    /// # Errors
+    /// As [`Solver::solve_frame`].
+    pub fn errors(&self, targets: &[Pose]) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        self.check_targets(targets)?;
+        Ok(self.tracking_errors(targets))
+    }
+
+    /// `targets` has a pose for every task's and point task's target slot.
+    fn check_targets(&self, targets: &[Pose]) -> Result<(), Error> {
+        let needed = self.stages.iter().flatten().map(|t| t.spec.target + 1).max().unwrap_or(0);
+        if targets.len() < needed {
+            return Err(Error::InvalidOption(format!(
+                "the tasks need {needed} target poses, {} were given",
+                targets.len()
+            )));
+        }
+        Ok(())
     }
 
     /// Joint-range bounds on Δq, intersected with the speed limits (per joint, or the global

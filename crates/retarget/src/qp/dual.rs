@@ -19,6 +19,11 @@
 //! one Cholesky factor and a few `O(n²)` updates per active constraint, and is exact;
 //! `benches/qp.rs` measures it against `clarabel` on QPs recorded from a G1 solve.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: dense linear algebra on buffers sized `n` in `DenseQp::new` and rows of length `n`
+// from `add_row`; indices stay below `n`, `num_rows` by construction.
+#![allow(clippy::indexing_slicing)]
+
 use super::QpStatus;
 
 /// A constraint of the problem: a bound of one variable or a general row.
