@@ -26,7 +26,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::motion::RobotMotion;
 
-pub(crate) use derived::{angular_velocity, body_poses, gradient_rows, BodyPoses};
+pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
 
 /// Output formats, chosen by file extension.
