@@ -18,7 +18,7 @@ mod pickle;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::motion::RobotMotion;
@@ -67,22 +67,9 @@ impl Format {
     }
 }
 
-/// Errors of the writers, the `.npz` reader and the quality report.
-#[derive(Debug, thiserror::Error)]
-pub enum Error {
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("{}: unknown output format (expected .npz, .csv, .pkl or .json)", path.display())]
-    UnknownFormat { path: PathBuf },
-    #[error("motion does not fit the robot model: {0}")]
-    Mismatch(String),
-    #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
-    NonFinite { frame: usize, index: usize, value: f64 },
-    #[error("{}: {message}", path.display())]
-    Read { path: PathBuf, message: String },
-    #[error("{0}")]
-    Options(String),
-}
+/// Errors of the writers, the `.npz` reader and the quality report: the crate's one
+/// [`crate::Error`].
+pub use crate::Error;
 
 /// Writes `motion` to `path` in `format` (by default the one of the extension), atomically.
 ///
@@ -157,7 +144,7 @@ pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<
     }
     if let Some(i) = motion.qpos.iter().position(|v| !v.is_finite()) {
         let (frame, index) = (i / motion.nq, i % motion.nq);
-        return Err(Error::NonFinite { frame, index, value: motion.qpos[i] });
+        return Err(Error::NonFiniteQpos { frame, index, value: motion.qpos[i] });
     }
     if let Some(t) = &motion.targets {
         let expected = motion.num_frames() * t.body_names.len();
@@ -208,7 +195,7 @@ pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 {
-    let io_error = |source| Error::Io { path: path.to_path_buf(), source };
+    let io_error = |source| Error::File { path: path.to_path_buf(), source };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
     let tmp = path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()));

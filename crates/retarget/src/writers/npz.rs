@@ -84,7 +84,8 @@ pub(crate) fn write_npz<W: Write + Seek>(out: W, arrays: &[(&str, Array)]) -> st
 /// Every `<key>.npy` of an `.npz`, by key.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
     let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
-    let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let file =
+        File::open(path).map_err(|source| Error::File { path: path.to_path_buf(), source })?;
     let mut zip =
         zip::ZipArchive::new(file).map_err(|e| read_error(format!("not an .npz: {e}")))?;
     let mut arrays = BTreeMap::new();
