@@ -260,10 +260,19 @@ impl Retargeter {
     /// config used.
     pub fn retarget_bvh(&self, bvh: &Bvh) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let chosen = self.choose_config(bvh)?;
+        self.retarget_bvh_with(bvh, &chosen)
+    }
+
+    /// [`Retargeter::retarget_bvh`] with a config already chosen.
+    pub fn retarget_bvh_with(
+        &self,
+        bvh: &Bvh,
+        chosen: &Chosen,
+    ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let (motion, mut diag) =
             crate::pipeline::retarget_bvh(bvh, &self.model, &chosen.config, &self.options)?;
         diag.human_inferred = if diag.human_inferred.is_empty() {
-            chosen.summary
+            chosen.summary.clone()
         } else {
             format!("{}; {}", diag.human_inferred, chosen.summary)
         };
@@ -280,7 +289,7 @@ impl Retargeter {
     pub fn retarget(&self, human: &HumanMotion) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let config = self.motion_config()?;
         let height = self.options.human_height.unwrap_or(config.human_height_assumption);
-        self.solve_clip(human, config, height)
+        self.retarget_with(human, config, height)
     }
 
     /// Retargets a C3D clip through the virtual marker bodies of `markers` with `config` (the
@@ -293,7 +302,7 @@ impl Retargeter {
         config: &IkConfig,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let clip = markers.motion(file, name, self.options.human_height)?;
-        let (motion, mut diag) = self.solve_clip(&clip.human, config, clip.height)?;
+        let (motion, mut diag) = self.retarget_with(&clip.human, config, clip.height)?;
         diag.human_height_source = clip.height_source;
         Ok((motion, diag))
     }
@@ -314,7 +323,9 @@ impl Retargeter {
         self.retarget_c3d(&file, &name, &markers, &ik)
     }
 
-    fn solve_clip(
+    /// Retargets a human motion with `config` and the subject height `height` (metres),
+    /// serially or in chunks ([`RetargetOptions::chunk`]).
+    pub fn retarget_with(
         &self,
         human: &HumanMotion,
         config: &IkConfig,
