@@ -71,6 +71,7 @@ pub mod contact;
 pub mod derive;
 mod error;
 pub mod feet;
+pub mod gmr;
 pub mod joint_speed;
 pub mod lie;
 pub mod marker_config;
@@ -95,6 +96,6 @@ pub use pipeline::{
     retarget_bvh, retarget_motion, ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions,
     SolveMode, SpeedLimits,
 };
-pub use retargeter::{HumanFrame, Retargeter};
+pub use retargeter::{FileResult, HumanFrame, Retargeter};
 pub use robot_roles::{RobotRole, RobotRoles, Sole};
 pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};

@@ -18,7 +18,7 @@
 //!
 //! [`Planting::Off`]: crate::pipeline::Planting::Off
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use bvh::Bvh;
@@ -197,6 +197,12 @@ impl Retargeter {
     #[must_use]
     pub fn model(&self) -> &Model {
         &self.model
+    }
+
+    /// The model, shared (for motions that outlive the retargeter, e.g. to write them).
+    #[must_use]
+    pub fn shared_model(&self) -> Arc<Model> {
+        Arc::clone(&self.model)
     }
 
     /// The robot's name in messages: the shipped key or the model file's stem.
@@ -396,6 +402,55 @@ impl Retargeter {
         stream.step(frame)
     }
 
+    /// The targets of the last streamed frame: per scaled human body its name, world position
+    /// and orientation after scaling and offsets (GMR's `scaled_human_data`).
+    #[must_use]
+    pub fn last_step_targets(&self) -> Vec<(String, Pose)> {
+        let guard = self.stream.lock().unwrap_or_else(PoisonError::into_inner);
+        match guard.as_ref() {
+            Some(s) if s.frames > 0 => {
+                s.map.bodies.iter().map(|b| b.name.clone()).zip(s.targets.iter().copied()).collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    /// Retargets BVH files in parallel on a pool of `threads` threads (0: one per core): each
+    /// `(input, output)` pair is read, retargeted ([`Retargeter::retarget_bvh`]) and written
+    /// in the output's format (by extension). One result per pair, in order; a clip that fails
+    /// fails alone.
+    pub fn retarget_files(
+        &self,
+        pairs: &[(PathBuf, PathBuf)],
+        threads: usize,
+    ) -> Result<Vec<Result<FileResult, Error>>, Error> {
+        use rayon::prelude::*;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| Error::InvalidOption(format!("thread pool: {e}")))?;
+        Ok(pool.install(|| {
+            pairs.par_iter().map(|(input, output)| self.retarget_file(input, output)).collect()
+        }))
+    }
+
+    fn retarget_file(&self, input: &Path, output: &Path) -> Result<FileResult, Error> {
+        let started = std::time::Instant::now();
+        let in_file =
+            |e: Error| Error::InFile { path: input.display().to_string(), source: Box::new(e) };
+        let is_bvh = input.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
+        if !is_bvh {
+            return Err(in_file(Error::InvalidOption("not a .bvh file".to_owned())));
+        }
+        let (motion, diag) = self.retarget_bvh_file(input).map_err(in_file)?;
+        self.write(&motion, output, None)?;
+        Ok(FileResult {
+            frames: motion.num_frames(),
+            seconds: started.elapsed().as_secs_f64(),
+            inferred: diag.human_inferred,
+        })
+    }
+
     /// Diagnostics of the last streamed frame.
     #[must_use]
     pub fn last_step_diagnostics(&self) -> Option<FrameDiagnostics> {
@@ -414,6 +469,16 @@ impl Retargeter {
     pub fn reset(&mut self) {
         *self.stream.get_mut().unwrap_or_else(PoisonError::into_inner) = None;
     }
+}
+
+/// What [`Retargeter::retarget_files`] did with one file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FileResult {
+    pub frames: usize,
+    /// Wall time of this clip (read, solve, write).
+    pub seconds: f64,
+    /// What was inferred about the source and the config used.
+    pub inferred: String,
 }
 
 /// The options a stream runs: GMR's as given, else the default mode's causal part.

@@ -116,6 +116,16 @@ pub fn write_motion(
     }
 }
 
+/// The arrays [`write_motion`] puts in an `.npz`, in file order, by key (checked as
+/// `write_motion` checks): what the Python package hands over as numpy arrays.
+pub fn npz_arrays(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+) -> Result<Vec<(&'static str, npy::Array)>, Error> {
+    check_motion(motion, model)?;
+    Ok(npz::motion_arrays(motion, model))
+}
+
 /// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
 /// `root_rot` use it. The only place where our files change quaternion order.
 #[must_use]
