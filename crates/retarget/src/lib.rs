@@ -59,7 +59,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Underneath: [`config`] (GMR-schema IK configs), [`derive`] and [`robot_roles`] (configs
+//! Underneath: [`config`] (GMR-schema IK configs), [`derive`](mod@derive) and [`robot_roles`] (configs
 //! derived for any skeleton and robot), [`targets`], [`solver`] and [`pipeline`] (the solve:
 //! [`SolveMode::Gmr`] is GMR's exactly, the default adds planted feet and hard constraints),
 //! [`motion`], [`writers`] and [`report`]. Every fallible call returns the one [`Error`].
