@@ -15,11 +15,16 @@ impl Pos {
     /// The position of byte `offset` in `src` (clamped to the end of `src`).
     #[must_use]
     pub fn from_offset(src: &[u8], offset: usize) -> Pos {
-        let before = &src[..offset.min(src.len())];
+        let before = src.get(..offset).unwrap_or(src);
         let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
         let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
         // Count characters, not bytes: UTF-8 continuation bytes do not start a column.
-        let column = 1 + before[line_start..].iter().filter(|&&b| (b & 0xC0) != 0x80).count();
+        let column = 1 + before
+            .get(line_start..)
+            .unwrap_or_default()
+            .iter()
+            .filter(|&&b| (b & 0xC0) != 0x80)
+            .count();
         Pos { line, column }
     }
 }

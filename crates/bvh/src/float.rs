@@ -22,7 +22,9 @@ pub(crate) fn is_space(b: u8) -> bool {
 /// End of the whitespace-delimited token starting at `start`.
 #[inline]
 pub(crate) fn token_end(src: &[u8], start: usize) -> usize {
-    src[start..].iter().position(|&b| is_space(b)).map_or(src.len(), |n| start + n)
+    src.get(start..)
+        .and_then(|rest| rest.iter().position(|&b| is_space(b)))
+        .map_or(src.len(), |n| start + n)
 }
 
 /// Parse the whitespace-delimited token at `start` as a number. Returns the value (possibly
@@ -34,7 +36,7 @@ pub(crate) fn parse_number(src: &[u8], start: usize) -> Option<(f64, usize)> {
         return Some(hit);
     }
     let end = token_end(src, start);
-    let text = std::str::from_utf8(&src[start..end]).ok()?;
+    let text = std::str::from_utf8(src.get(start..end)?).ok()?;
     text.parse::<f64>().ok().map(|v| (v, end))
 }
 
@@ -79,8 +81,8 @@ fn fast_path(src: &[u8], start: usize) -> Option<(f64, usize)> {
     }
     let value = mantissa as f64;
     let value = match exponent {
-        0..=22 => value * POW10[exponent as usize],
-        -22..=-1 => value / POW10[(-exponent) as usize],
+        0..=22 => value * POW10.get(exponent as usize)?,
+        -22..=-1 => value / POW10.get((-exponent) as usize)?,
         _ => return None,
     };
     Some((if negative { -value } else { value }, i))

@@ -55,17 +55,19 @@ fn scale_warnings(src: &[u8], bvh: &Bvh, scaled: &[(usize, usize)]) -> Vec<Warni
     let m = &bvh.motion;
     scaled
         .iter()
-        .map(|&(id, at)| {
-            let joint = &bvh.skeleton.joints[id];
+        .filter_map(|&(id, at)| {
+            let joint = bvh.skeleton.joints.get(id)?;
             let columns = (joint.channels.iter().enumerate())
                 .filter(|(_, c)| matches!(c, Channel::Scale(_)))
                 .map(|(k, _)| joint.first_channel + k);
-            let values = columns.flat_map(|c| (0..m.num_frames).map(move |f| m.frame(f)[c]));
+            let values = columns.flat_map(|c| {
+                (0..m.num_frames).filter_map(move |f| m.values.get(f * m.num_channels + c).copied())
+            });
             let range = values
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
             let (min, max) = if range.0 <= range.1 { range } else { (1.0, 1.0) };
             let pos = Pos::from_offset(src, at);
-            Warning::ScaleChannels { pos, joint: joint.name.clone(), min, max }
+            Some(Warning::ScaleChannels { pos, joint: joint.name.clone(), min, max })
         })
         .collect()
 }
@@ -97,7 +99,7 @@ fn describe(token: Option<&[u8]>) -> String {
     match token {
         None => "end of file".to_owned(),
         Some(t) => {
-            let text = String::from_utf8_lossy(&t[..t.len().min(40)]);
+            let text = String::from_utf8_lossy(t.get(..40).unwrap_or(t));
             let more = if t.len() > 40 { "…" } else { "" };
             format!("`{text}{more}`")
         }
@@ -129,7 +131,7 @@ impl<'a> Parser<'a> {
             return (start, None);
         }
         self.pos = token_end(self.src, start);
-        (start, Some(&self.src[start..self.pos]))
+        (start, Some(self.src.get(start..self.pos).unwrap_or_default()))
     }
 
     fn peek(&mut self) -> (usize, Option<&'a [u8]>) {
@@ -158,12 +160,15 @@ impl<'a> Parser<'a> {
     fn rest_of_line(&mut self) -> (usize, &'a [u8]) {
         self.skip_inline_space();
         let start = self.pos;
-        let end = self.src[start..]
+        let end = self
+            .src
+            .get(start..)
+            .unwrap_or_default()
             .iter()
             .position(|&b| b == b'\n')
             .map_or(self.src.len(), |n| start + n);
         self.pos = end;
-        (start, trim_end_space(&self.src[start..end]))
+        (start, trim_end_space(self.src.get(start..end).unwrap_or_default()))
     }
 
     /// A number token that must be finite.
@@ -185,8 +190,8 @@ impl<'a> Parser<'a> {
 
     /// The error for a token that is not a finite number (`parsed`: it is NaN or infinite).
     fn number_error(&self, at: usize, len: usize, parsed: bool) -> Error {
-        let text = &self.src[at..at + len];
-        let token = String::from_utf8_lossy(&text[..text.len().min(40)]).into_owned();
+        let text = self.src.get(at..at + len).unwrap_or_default();
+        let token = String::from_utf8_lossy(text.get(..40).unwrap_or(text)).into_owned();
         let pos = self.at(at);
         if parsed {
             Error::NonFinite { pos, token }
@@ -241,7 +246,8 @@ impl<'a> Parser<'a> {
         let mut stack = vec![self.open(skeleton, JointKind::Root, None)?];
         while let Some(top) = stack.last_mut() {
             let id = top.id;
-            let kind = skeleton.joints[id].kind;
+            // `id` was pushed by `open`, which added the joint: it exists.
+            let kind = skeleton.joints.get(id).map_or(JointKind::End, |j| j.kind);
             let (at, token) = self.token();
             match token {
                 Some(t) if is_keyword(t, "OFFSET") => {
@@ -249,7 +255,10 @@ impl<'a> Parser<'a> {
                         return Err(Error::Invalid { pos: self.at(at), what: "duplicate OFFSET" });
                     }
                     top.has_offset = true;
-                    skeleton.joints[id].offset = self.offset()?;
+                    let offset = self.offset()?;
+                    if let Some(joint) = skeleton.joints.get_mut(id) {
+                        joint.offset = offset;
+                    }
                 }
                 Some(t) if is_keyword(t, "CHANNELS") && kind != JointKind::End => {
                     if top.has_channels {
@@ -269,9 +278,10 @@ impl<'a> Parser<'a> {
                         scaled.push((id, at));
                     }
                     let first = skeleton.num_channels();
-                    let joint = &mut skeleton.joints[id];
-                    joint.first_channel = first;
-                    joint.channels = channels;
+                    if let Some(joint) = skeleton.joints.get_mut(id) {
+                        joint.first_channel = first;
+                        joint.channels = channels;
+                    }
                 }
                 Some(t) if is_keyword(t, "JOINT") && kind != JointKind::End => {
                     top.has_children = true;
@@ -320,7 +330,7 @@ impl<'a> Parser<'a> {
     ) -> Error {
         Error::MissingBrace {
             pos: self.at(at),
-            joint: skeleton.joints[id].name.clone(),
+            joint: skeleton.joints.get(id).map(|j| j.name.clone()).unwrap_or_default(),
             open: self.at(brace),
             found: describe(token),
         }
@@ -347,7 +357,8 @@ impl<'a> Parser<'a> {
                 if !name.is_empty() {
                     return Err(self.expected(at, "`{` after End Site", Some(name)));
                 }
-                let parent = parent.map_or("", |p| skeleton.joints[p].name.as_str());
+                let parent =
+                    parent.and_then(|p| skeleton.joints.get(p)).map_or("", |j| j.name.as_str());
                 format!("{parent}_End")
             }
             _ if name.is_empty() => {
@@ -391,7 +402,7 @@ impl<'a> Parser<'a> {
         loop {
             let (at, token) = self.peek();
             let Some(t) = token else { break };
-            let same_line = !self.src[self.pos..at].contains(&b'\n');
+            let same_line = !self.src.get(self.pos..at).unwrap_or_default().contains(&b'\n');
             if channels.len() >= declared && !same_line {
                 break;
             }
@@ -556,8 +567,10 @@ impl<'a> Parser<'a> {
         }
         self.pos = pos;
         if found < num_channels {
-            let end = if src[..pos].ends_with(b"\n") { pos - 1 } else { pos };
-            let end = src[..end].iter().rposition(|&b| !is_space(b)).map_or(end, |i| i + 1);
+            let before = src.get(..pos).unwrap_or(src);
+            let end = if before.ends_with(b"\n") { pos - 1 } else { pos };
+            let before = src.get(..end).unwrap_or(src);
+            let end = before.iter().rposition(|&b| !is_space(b)).map_or(end, |i| i + 1);
             return Err(Error::FrameLength {
                 pos: self.at(end),
                 frame,
@@ -570,12 +583,20 @@ impl<'a> Parser<'a> {
 
     /// The error for a row with more than `expected` values; `extra` is the first extra one.
     fn long_row(&self, extra: usize, frame: usize, expected: usize) -> Error {
-        let line_end = self.src[extra..]
+        let line_end = self
+            .src
+            .get(extra..)
+            .unwrap_or_default()
             .iter()
             .position(|&b| b == b'\n')
             .map_or(self.src.len(), |n| extra + n);
-        let more =
-            self.src[extra..line_end].split(|&b| is_space(b)).filter(|t| !t.is_empty()).count();
+        let more = self
+            .src
+            .get(extra..line_end)
+            .unwrap_or_default()
+            .split(|&b| is_space(b))
+            .filter(|t| !t.is_empty())
+            .count();
         Error::FrameLength { pos: self.at(extra), frame, found: expected + more, expected }
     }
 }
@@ -599,5 +620,5 @@ fn trim_end_space(mut text: &[u8]) -> &[u8] {
 
 fn strip_prefix_ignore_case<'t>(token: &'t [u8], prefix: &[u8]) -> Option<&'t [u8]> {
     let head = token.get(..prefix.len())?;
-    head.eq_ignore_ascii_case(prefix).then(|| &token[prefix.len()..])
+    head.eq_ignore_ascii_case(prefix).then(|| token.get(prefix.len()..)).flatten()
 }

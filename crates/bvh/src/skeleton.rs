@@ -102,7 +102,12 @@ impl Skeleton {
         self.joints.iter().position(|j| j.name == name).map(JointId)
     }
 
+    /// # Panics
+    /// If `id` is not a joint of this skeleton (ids from [`Skeleton::find`] and
+    /// [`Joint::parent`] always are).
     #[must_use]
+    // A caller's out-of-range id is a bug, like slice indexing; file input never reaches it.
+    #[allow(clippy::indexing_slicing)]
     pub fn joint(&self, id: JointId) -> &Joint {
         &self.joints[id.0]
     }
@@ -120,7 +125,12 @@ pub struct Motion {
 
 impl Motion {
     /// One frame's channel values.
+    ///
+    /// # Panics
+    /// If `index >= num_frames` (a parsed motion holds `num_frames × num_channels` values).
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing; file input never reaches it.
+    #[allow(clippy::indexing_slicing)]
     pub fn frame(&self, index: usize) -> &[f64] {
         &self.values[index * self.num_channels..(index + 1) * self.num_channels]
     }

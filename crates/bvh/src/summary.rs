@@ -77,16 +77,18 @@ impl Summary {
     pub fn new(bvh: &Bvh, name: &str) -> Summary {
         let joints = &bvh.skeleton.joints;
         let num_end_sites = joints.iter().filter(|j| j.kind == JointKind::End).count();
-        let mut depth = vec![0usize; joints.len()];
+        let mut depth: Vec<usize> = Vec::with_capacity(joints.len());
         let tree = joints
             .iter()
             .enumerate()
             .map(|(i, j)| {
-                depth[i] = j.parent.filter(|p| p.0 < i).map_or(0, |p| depth[p.0] + 1);
+                let d =
+                    j.parent.filter(|p| p.0 < i).and_then(|p| depth.get(p.0)).map_or(0, |d| d + 1);
+                depth.push(d);
                 SummaryJoint {
                     name: j.name.clone(),
                     kind: j.kind,
-                    depth: depth[i],
+                    depth: d,
                     channels: j.channels.clone(),
                 }
             })
@@ -157,18 +159,19 @@ fn axis_name(a: Axis) -> char {
 
 /// Largest side of the bounding box of all joints in the rest pose (offsets only).
 fn rest_extent(skeleton: &Skeleton) -> f64 {
-    let mut pos = vec![[0.0f64; 3]; skeleton.joints.len()];
+    let mut pos: Vec<[f64; 3]> = Vec::with_capacity(skeleton.joints.len());
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for (i, j) in skeleton.joints.iter().enumerate() {
-        if let Some(p) = j.parent.filter(|p| p.0 < i) {
-            pos[i] = std::array::from_fn(|k| pos[p.0][k] + j.offset[k]);
-        }
-        for k in 0..3 {
-            lo[k] = lo[k].min(pos[i][k]);
-            hi[k] = hi[k].max(pos[i][k]);
+    for j in &skeleton.joints {
+        let parent = j.parent.and_then(|p| pos.get(p.0)).copied();
+        let here = parent
+            .map_or([0.0; 3], |p| [p[0] + j.offset[0], p[1] + j.offset[1], p[2] + j.offset[2]]);
+        pos.push(here);
+        for ((lo, hi), v) in lo.iter_mut().zip(hi.iter_mut()).zip(here) {
+            *lo = lo.min(v);
+            *hi = hi.max(v);
         }
     }
-    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+    lo.iter().zip(&hi).map(|(lo, hi)| hi - lo).fold(0.0, f64::max)
 }
 
 impl fmt::Display for Summary {

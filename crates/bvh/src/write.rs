@@ -21,8 +21,9 @@ pub fn write(bvh: &Bvh, out: impl Write) -> io::Result<()> {
     w.write_all(b"HIERARCHY\n")?;
     let mut num = ryu::Buffer::new();
     for step in tree.walk() {
-        let joint = &bvh.skeleton.joints[step.joint()];
-        let indent = "\t".repeat(tree.depth[step.joint()]);
+        // The walk visits only joints `Tree::new` checked.
+        let Some(joint) = bvh.skeleton.joints.get(step.joint()) else { continue };
+        let indent = "\t".repeat(tree.depth.get(step.joint()).copied().unwrap_or(0));
         match step {
             Step::Enter(_) => write_joint_head(&mut w, joint, &indent, &mut num)?,
             Step::Exit(_) => writeln!(w, "{indent}}}")?,
@@ -38,7 +39,7 @@ pub fn write(bvh: &Bvh, out: impl Write) -> io::Result<()> {
             if i > 0 {
                 w.write_all(b" ")?;
             }
-            w.write_all(short(&mut num, row[c]).as_bytes())?;
+            w.write_all(short(&mut num, row.get(c).copied().unwrap_or(0.0)).as_bytes())?;
         }
         w.write_all(b"\n")?;
     }
@@ -103,10 +104,12 @@ pub fn write_json(bvh: &Bvh, out: impl Write) -> io::Result<()> {
         let id = step.joint();
         match step {
             Step::Enter(_) => {
-                if !tree.first_sibling[id] {
+                if !tree.first_sibling.get(id).copied().unwrap_or(true) {
                     w.write_all(b",")?;
                 }
-                json_joint(&mut w, &mut num, &bvh.skeleton.joints[id], m)?;
+                if let Some(joint) = bvh.skeleton.joints.get(id) {
+                    json_joint(&mut w, &mut num, joint, m)?;
+                }
             }
             Step::Exit(_) => w.write_all(b"]}")?,
         }
@@ -141,7 +144,7 @@ fn json_joint(
     if !columns.is_empty() {
         for frame in 0..m.num_frames {
             w.write_all(if frame > 0 { b",\n" } else { b"\n" })?;
-            json_array(w, num, &m.frame(frame)[columns.clone()])?;
+            json_array(w, num, m.frame(frame).get(columns.clone()).unwrap_or_default())?;
         }
     }
     w.write_all(b"],\"children\":[")
@@ -257,13 +260,21 @@ impl Tree {
             first_sibling: vec![false; n],
         };
         for (i, joint) in joints.iter().enumerate() {
-            let siblings = match (joint.parent, joint.kind) {
-                (None, JointKind::Root) => &mut tree.roots,
-                (Some(p), JointKind::Joint | JointKind::End)
-                    if p.0 < i && joints[p.0].kind != JointKind::End =>
+            let parent =
+                joint.parent.filter(|p| p.0 < i).and_then(|p| Some((p.0, joints.get(p.0)?)));
+            let siblings = match (parent, joint.kind) {
+                (None, JointKind::Root) if joint.parent.is_none() => &mut tree.roots,
+                (Some((p, parent)), JointKind::Joint | JointKind::End)
+                    if parent.kind != JointKind::End =>
                 {
-                    tree.depth[i] = tree.depth[p.0] + 1;
-                    &mut tree.children[p.0]
+                    let depth = tree.depth.get(p).map_or(0, |d| d + 1);
+                    if let Some(slot) = tree.depth.get_mut(i) {
+                        *slot = depth;
+                    }
+                    match tree.children.get_mut(p) {
+                        Some(children) => children,
+                        None => return Err(invalid(format!("joint {i}: bad parent"))),
+                    }
                 }
                 _ => {
                     return Err(invalid(format!(
@@ -272,7 +283,10 @@ impl Tree {
                     )))
                 }
             };
-            tree.first_sibling[i] = siblings.is_empty();
+            let first = siblings.is_empty();
+            if let Some(slot) = tree.first_sibling.get_mut(i) {
+                *slot = first;
+            }
             siblings.push(i);
             if joint.kind == JointKind::End && !joint.channels.is_empty() {
                 return Err(invalid(format!("End Site `{}` has channels", joint.name)));
@@ -289,7 +303,8 @@ impl Tree {
             let step = stack.pop()?;
             if let Step::Enter(j) = step {
                 stack.push(Step::Exit(j));
-                stack.extend(self.children[j].iter().rev().map(|&c| Step::Enter(c)));
+                let children = self.children.get(j).map_or(&[][..], Vec::as_slice);
+                stack.extend(children.iter().rev().map(|&c| Step::Enter(c)));
             }
             Some(step)
         })
@@ -300,9 +315,9 @@ impl Tree {
         let joints = &bvh.skeleton.joints;
         self.walk()
             .filter_map(|s| match s {
-                Step::Enter(j) => Some(
-                    joints[j].first_channel..joints[j].first_channel + joints[j].channels.len(),
-                ),
+                Step::Enter(j) => {
+                    joints.get(j).map(|j| j.first_channel..j.first_channel + j.channels.len())
+                }
                 Step::Exit(_) => None,
             })
             .flatten()

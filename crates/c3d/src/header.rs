@@ -55,6 +55,9 @@ pub struct Header {
 
 impl Header {
     /// Decodes a header block read with the given processor's byte order.
+    // Fixed offsets into a fixed 512-byte block (words 1..=152, event bytes up to 467):
+    // every index is a constant bounded below BLOCK, whatever the file says.
+    #[allow(clippy::indexing_slicing)]
     pub fn parse(b: &[u8; BLOCK], p: Processor) -> Header {
         let word = |n: usize| p.u16([b[2 * (n - 1)], b[2 * (n - 1) + 1]]);
         let float = |n: usize| {
@@ -87,6 +90,8 @@ impl Header {
     }
 
     /// Encodes the header with the given processor's byte order.
+    // Fixed offsets into a fixed 512-byte block, as in `parse`; at most 18 events.
+    #[allow(clippy::indexing_slicing)]
     pub fn to_bytes(&self, p: Processor) -> [u8; BLOCK] {
         let mut b = [0u8; BLOCK];
         let put16 = |b: &mut [u8; BLOCK], n: usize, v: u16| {

@@ -201,7 +201,10 @@ fn analog_transform(params: &Parameters, channels: usize) -> (Vec<i32>, Vec<f32>
 fn frames(header: &Header, params: &Parameters) -> (u32, usize) {
     let field = |name: &str| {
         let w = params.get("TRIAL", name)?.u16s();
-        (w.len() >= 2).then(|| u32::from(w[0]) + 65536 * u32::from(w[1]))
+        match w.as_slice() {
+            [lo, hi, ..] => Some(u32::from(*lo) + 65536 * u32::from(*hi)),
+            _ => None,
+        }
     };
     if let (Some(start), Some(end)) = (field("ACTUAL_START_FIELD"), field("ACTUAL_END_FIELD")) {
         if end >= start && end >= u32::from(header.last_frame) {

@@ -58,8 +58,13 @@ impl Points {
         if point >= n || frame >= self.frame_count {
             return false;
         }
-        self.data[frame * n + point] = value;
-        true
+        match self.data.get_mut(frame * n + point) {
+            Some(slot) => {
+                *slot = value;
+                true
+            }
+            None => false,
+        }
     }
 
     /// Index of a label (exact match after trimming).
@@ -139,7 +144,8 @@ impl Analog {
     /// One channel over time.
     pub fn channel(&self, channel: usize) -> impl Iterator<Item = f32> + '_ {
         let n = self.channel_count();
-        let data: &[f32] = if channel < n { &self.data[channel..] } else { &[] };
+        // With no samples (a file of 0 frames) `data` is empty while `channel < n`.
+        let data: &[f32] = if channel < n { self.data.get(channel..).unwrap_or(&[]) } else { &[] };
         data.iter().step_by(n.max(1)).copied()
     }
 }
@@ -333,7 +339,8 @@ fn events(header: &Header, params: &Parameters, warnings: &mut Vec<String>) -> V
     out.extend((0..n).map(|i| Event {
         label: text(&labels, i),
         context: text(&contexts, i),
-        time: (f64::from(times[2 * i]) * 60.0 + f64::from(times[2 * i + 1])) as f32,
+        time: (f64::from(times.get(2 * i).copied().unwrap_or(0.0)) * 60.0
+            + f64::from(times.get(2 * i + 1).copied().unwrap_or(0.0))) as f32,
         description: text(&descriptions, i),
         display: None,
         source: EventSource::Parameters,

@@ -268,7 +268,7 @@ impl Parameters {
         let before = g.parameters.len();
         let is_continuation = |p: &str| {
             p.get(..name.len()).is_some_and(|head| head.eq_ignore_ascii_case(name))
-                && p[name.len()..].parse::<u32>().is_ok_and(|n| n >= 2)
+                && p.get(name.len()..).and_then(|n| n.parse::<u32>().ok()).is_some_and(|n| n >= 2)
         };
         g.parameters.retain(|p| !(p.name.eq_ignore_ascii_case(name) || is_continuation(&p.name)));
         g.parameters.len() != before
@@ -276,6 +276,8 @@ impl Parameters {
 
     fn group_mut_or_insert(&mut self, name: &str) -> &mut Group {
         if let Some(i) = self.groups.iter().position(|g| g.name.eq_ignore_ascii_case(name)) {
+            // `i` was just found in `groups`.
+            #[allow(clippy::indexing_slicing)]
             return &mut self.groups[i];
         }
         let id = (1..=127u8).find(|id| self.groups.iter().all(|g| g.id != *id)).unwrap_or(127);
@@ -287,6 +289,8 @@ impl Parameters {
             parameters: vec![],
         });
         let last = self.groups.len() - 1;
+        // Just pushed: `groups` is not empty.
+        #[allow(clippy::indexing_slicing)]
         &mut self.groups[last]
     }
 }
@@ -356,14 +360,15 @@ fn parse_item(buf: &[u8], pos: usize, p: Processor) -> Result<(Item, Next), Stri
             .and_then(|end| buf.get(at..end))
             .ok_or_else(|| "it runs past the end of the section".to_string())
     };
-    let name_len = buf[pos] as i8;
-    let id = buf[pos + 1] as i8;
+    let head = take(pos, 2)?;
+    let (name_len, id) =
+        (head.first().copied().unwrap_or(0) as i8, head.get(1).copied().unwrap_or(0) as i8);
     let locked = name_len < 0;
     let n = usize::from(name_len.unsigned_abs());
     let name = latin1(take(pos + 2, n)?);
     let off_at = pos + 2 + n;
     let o = take(off_at, 2)?;
-    let offset = p.i16([o[0], o[1]]);
+    let offset = p.i16(crate::processor::take(o));
     let next = match offset {
         0 => Next::Last,
         o if o > 0 && off_at + o as usize > pos + 2 => Next::At(off_at + o as usize),
@@ -376,7 +381,8 @@ fn parse_item(buf: &[u8], pos: usize, p: Processor) -> Result<(Item, Next), Stri
         return Ok((Item::Group(group), next));
     }
     let t = take(at, 2)?;
-    let (type_byte, ndims) = (t[0] as i8, usize::from(t[1]));
+    let [type_byte, ndims] = crate::processor::take::<2>(t);
+    let (type_byte, ndims) = (type_byte as i8, usize::from(ndims));
     at += 2;
     let dims: Vec<usize> = take(at, ndims)?.iter().map(|&d| usize::from(d)).collect();
     at += ndims;
@@ -394,8 +400,8 @@ fn parse_item(buf: &[u8], pos: usize, p: Processor) -> Result<(Item, Next), Stri
     let data = match type_byte {
         -1 => Data::Char(raw.to_vec()),
         1 => Data::Byte(raw.to_vec()),
-        2 => Data::Int16(raw.chunks_exact(2).map(|c| p.i16([c[0], c[1]])).collect()),
-        _ => Data::Float(raw.chunks_exact(4).map(|c| p.f32([c[0], c[1], c[2], c[3]])).collect()),
+        2 => Data::Int16(raw.chunks_exact(2).map(|c| p.i16(crate::processor::take(c))).collect()),
+        _ => Data::Float(raw.chunks_exact(4).map(|c| p.f32(crate::processor::take(c))).collect()),
     };
     // A missing description at the very end is tolerated (some writers omit it).
     let description = read_description(buf, &mut at).unwrap_or_default();
@@ -454,18 +460,23 @@ pub(crate) fn encode(params: &Parameters, p: Processor) -> Result<Vec<u8>, Error
     }
     let last = items.len().saturating_sub(1);
     for (i, item) in items.iter_mut().enumerate() {
-        let name_len = usize::from((item[0] as i8).unsigned_abs());
+        let name_len = usize::from((item.first().copied().unwrap_or(0) as i8).unsigned_abs());
         let off_at = 2 + name_len;
         // Offset from the offset field to the next item's first byte.
         let offset = if i == last { 0 } else { (item.len() - off_at) as u16 };
-        item[off_at..off_at + 2].copy_from_slice(&encode_u16(p, offset));
+        if let Some(field) = item.get_mut(off_at..off_at + 2) {
+            field.copy_from_slice(&encode_u16(p, offset));
+        }
         out.extend_from_slice(item);
     }
     out.extend_from_slice(&[0, 0]);
     let blocks = out.len().div_ceil(BLOCK);
-    out[2] = u8::try_from(blocks).map_err(|_| {
+    let count = u8::try_from(blocks).map_err(|_| {
         Error::Write(format!("parameter section needs {blocks} blocks (at most 255)"))
     })?;
+    if let Some(slot) = out.get_mut(2) {
+        *slot = count;
+    }
     out.resize(blocks * BLOCK, 0);
     Ok(out)
 }

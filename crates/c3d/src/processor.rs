@@ -71,6 +71,12 @@ impl Processor {
 /// exponent is `e − 2`: exact for `e ≥ 3`; `e` of 1 and 2 become IEEE subnormals (rounded once,
 /// through `f64`). Exponent 0 is zero, or with the sign set a "reserved operand", returned as NaN.
 #[must_use]
+/// The first `N` bytes of `c` (zeros when shorter: callers pass exact chunks).
+#[inline]
+pub(crate) fn take<const N: usize>(c: &[u8]) -> [u8; N] {
+    c.first_chunk::<N>().copied().unwrap_or([0; N])
+}
+
 pub fn vax_f_to_f32(b: [u8; 4]) -> f32 {
     let hi = u32::from(u16::from_le_bytes([b[0], b[1]]));
     let lo = u32::from(u16::from_le_bytes([b[2], b[3]]));

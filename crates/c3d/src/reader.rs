@@ -5,7 +5,7 @@ use std::io::{Read, Seek, SeekFrom};
 use crate::header::{Header, BLOCK, KEY};
 use crate::layout::{DataFormat, Layout};
 use crate::params::{self, Parameters};
-use crate::processor::Processor;
+use crate::processor::{take as word_bytes, Processor};
 use crate::Error;
 
 /// One marker sample. Invalid samples (residual word −1) are `None` in [`Frame::points`].
@@ -162,27 +162,30 @@ pub(crate) fn decode_frame(layout: &Layout, bytes: &[u8], frame: &mut Frame) {
     let word = layout.word_size();
     let (point_bytes, analog_bytes) = bytes.split_at(4 * word * layout.point_count);
     let value = |c: &[u8]| match layout.format {
-        DataFormat::Integer => f32::from(p.i16([c[0], c[1]])),
-        DataFormat::Float => p.f32([c[0], c[1], c[2], c[3]]),
+        DataFormat::Integer => f32::from(p.i16(word_bytes(c))),
+        DataFormat::Float => p.f32(word_bytes(c)),
     };
+    let at = |c: &[u8], k: usize| value(c.get(k * word..).unwrap_or_default());
     let scale = layout.point_scale.abs();
     frame.points.clear();
     frame.points.extend(point_bytes.chunks_exact(4 * word).map(|c| {
-        let v =
-            [value(&c[..word]), value(&c[word..]), value(&c[2 * word..]), value(&c[3 * word..])];
+        let v = [at(c, 0), at(c, 1), at(c, 2), at(c, 3)];
         decode_point(v, layout.format, layout.point_scale, scale)
     }));
     let channels = layout.analog_channels.max(1);
     frame.analog.clear();
     frame.analog.extend(analog_bytes.chunks_exact(word).enumerate().map(|(i, c)| {
         let raw = match layout.format {
-            DataFormat::Integer if layout.analog_unsigned => f64::from(p.u16([c[0], c[1]])),
-            DataFormat::Integer => f64::from(p.i16([c[0], c[1]])),
-            DataFormat::Float => f64::from(p.f32([c[0], c[1], c[2], c[3]])),
+            DataFormat::Integer if layout.analog_unsigned => f64::from(p.u16(word_bytes(c))),
+            DataFormat::Integer => f64::from(p.i16(word_bytes(c))),
+            DataFormat::Float => f64::from(p.f32(word_bytes(c))),
         };
         let ch = i % channels;
-        let gain = f64::from(layout.analog_scales[ch]) * f64::from(layout.analog_gen_scale);
-        ((raw - f64::from(layout.analog_offsets[ch])) * gain) as f32
+        // `Layout` holds one scale and offset per channel.
+        let scale = layout.analog_scales.get(ch).copied().unwrap_or(1.0);
+        let offset = layout.analog_offsets.get(ch).copied().unwrap_or(0);
+        let gain = f64::from(scale) * f64::from(layout.analog_gen_scale);
+        ((raw - f64::from(offset)) * gain) as f32
     }));
 }
 

@@ -128,20 +128,22 @@ impl C3d {
             && gen_scale != 0.0;
         if reuse {
             t = AnalogTransform {
-                offsets: offsets[..n].iter().map(|&o| i32::from(o)).collect(),
-                scales: scales[..n].to_vec(),
+                offsets: offsets.iter().take(n).map(|&o| i32::from(o)).collect(),
+                scales: scales.iter().take(n).copied().collect(),
                 gen_scale,
             };
         }
         for c in 0..n {
             let max = self.analog.channel(c).fold(0f32, |m, v| m.max(v.abs()));
             let keep = reuse
-                && t.scales[c] != 0.0
+                && t.scales.get(c).is_some_and(|&s| s != 0.0)
                 && self.analog.channel(c).all(|v| quantise_analog(v, c, &t).is_some());
             if !keep {
-                t.offsets[c] = 0;
-                t.scales[c] =
+                let scale =
                     if max > 0.0 && max.is_finite() { max / INT_RANGE / t.gen_scale } else { 1.0 };
+                if let (Some(o), Some(s)) = (t.offsets.get_mut(c), t.scales.get_mut(c)) {
+                    (*o, *s) = (0, scale);
+                }
             }
         }
         t
@@ -341,8 +343,8 @@ fn encode_point(point: Option<&Point>, data: DataFormat, scale: f32) -> Option<[
 }
 
 fn quantise_analog(v: f32, c: usize, t: &AnalogTransform) -> Option<i16> {
-    let gain = f64::from(t.scales[c]) * f64::from(t.gen_scale);
-    let raw = (f64::from(v) / gain + f64::from(t.offsets[c])).round();
+    let gain = f64::from(*t.scales.get(c)?) * f64::from(t.gen_scale);
+    let raw = (f64::from(v) / gain + f64::from(*t.offsets.get(c)?)).round();
     (raw.is_finite() && (-32768.0..=32767.0).contains(&raw)).then_some(raw as i16)
 }
 

@@ -284,7 +284,7 @@ where
         .parent()
         .map_or(Ok(()), std::fs::create_dir_all)
         .with_context(|| format!("{}: cannot create directory", output.display()))
-        .and_then(|()| convert(&input, &output));
+        .and_then(|()| convert_isolated(convert, &input, &output));
     let seconds = started.elapsed().as_secs_f64();
     match result {
         Ok(clip) => {
@@ -308,6 +308,24 @@ where
         }
     }
     row
+}
+
+/// `convert(input, output)` with a panic turned into this clip's error: the library crates
+/// promise not to panic on input, and should that promise break, one clip fails (with the
+/// panic's message, to report) while the batch goes on and writes its summary.
+fn convert_isolated<F>(convert: &F, input: &Path, output: &Path) -> anyhow::Result<ClipResult>
+where
+    F: Fn(&Path, &Path) -> anyhow::Result<ClipResult>,
+{
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| convert(input, output)))
+        .unwrap_or_else(|payload| {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_owned())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "no message".to_owned());
+            bail!("{}: internal error (a bug, please report it): {message}", input.display())
+        })
 }
 
 /// A progress bar on a terminal, plain log lines otherwise.
@@ -457,6 +475,9 @@ mod tests {
         if text.contains("bad") {
             bail!("{}: cannot convert", input.display());
         }
+        if text.contains("panic") {
+            panic!("a bug met {}", text.len());
+        }
         crate::atomic_write(output, text.to_uppercase().as_bytes())?;
         Ok(ClipResult {
             frames: text.len(),
@@ -492,6 +513,28 @@ mod tests {
         )
         .unwrap();
         assert_eq!(written, third);
+    }
+
+    /// Issue 15: a panic in one clip's conversion must not take the batch down.
+    #[test]
+    fn a_panicking_clip_fails_alone_and_the_summary_is_written() {
+        let input = tree(&["a.bvh", "b/panic.bvh", "c.bvh"]);
+        let output = tempdir::Dir::new();
+        let summary = run(&plan(input.path(), output.path(), false), fake_convert).unwrap();
+        assert_eq!((summary.totals.converted, summary.totals.failed), (2, 1));
+        let failed = summary.clips.iter().find(|c| c.status == "failed").unwrap();
+        assert_eq!(failed.input, "b/panic.bvh");
+        let error = failed.error.as_deref().unwrap();
+        assert!(
+            error.ends_with("panic.bvh: internal error (a bug, please report it): a bug met 11"),
+            "{error}"
+        );
+        assert!(!output.path().join("b/panic.out").exists());
+        let written: Summary = serde_json::from_str(
+            &std::fs::read_to_string(output.path().join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(written, summary);
     }
 
     #[test]

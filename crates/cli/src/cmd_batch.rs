@@ -7,28 +7,32 @@ use anyhow::{bail, Context};
 use clap::Args;
 
 use retarget::writers::{write_motion, Format};
-use retarget::{IkConfig, RetargetOptions};
+use retarget::{IkConfig, MarkerConfig, RetargetOptions, Retargeter};
 
 use crate::batch::{self, ClipResult, Plan, Shard, Summary};
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
-    /// Directory tree of BVH files; relative paths are mirrored into the output directory.
-    #[arg(required_unless_present = "merge_summaries")]
+    /// Directory tree of BVH (and C3D) files; relative paths are mirrored into the output
+    /// directory. Required unless --merge-summaries.
+    #[arg(value_name = "IN_DIR", required_unless_present = "merge_summaries")]
     pub input: Option<PathBuf>,
-    /// Robot: a shipped name (see `retarget robots`) or a path to an MJCF file (with --config).
+    /// Robot (required unless --merge-summaries): a shipped name (see `retarget robots`) or a
+    /// path to an MJCF (.xml) or URDF (.urdf) file (with --config).
     #[arg(long, required_unless_present = "merge_summaries")]
     pub robot: Option<String>,
-    /// Output directory (created if missing); with --merge-summaries, the merged JSON file.
+    /// Output directory (required; created if missing); with --merge-summaries, the merged
+    /// JSON file.
     #[arg(short, long, required = true)]
     pub output: Option<PathBuf>,
-    /// IK config (GMR JSON schema), for every clip (bound to each skeleton when role-named);
+    /// IK config (GMR schema) for every clip (bound to each skeleton when role-named);
     /// default: per clip, GMR's tuned config or one derived from the roles (as without
-    /// --config in the main command).
-    #[arg(long)]
+    /// --config in the main command). C3D clips need a marker config (with `marker_bodies`,
+    /// e.g. configs/c3d_plugingait_to_unitree_g1.json).
+    #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Output format of every clip.
-    #[arg(long, default_value = "npz", value_parser = ["npz", "csv", "pkl", "json"])]
+    #[arg(long, value_name = "FORMAT", default_value = "npz", value_parser = crate::cmd_retarget::FORMATS)]
     pub format: String,
     /// Clips converted at once (default: the number of cores).
     #[arg(long)]
@@ -42,10 +46,19 @@ pub struct BatchArgs {
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
     /// Subject height in metres for every clip (default: estimated per clip from its skeleton).
-    #[arg(long)]
+    #[arg(long, value_name = "METRES")]
     pub human_height: Option<f64>,
+    /// Output frame rate: each solved motion is resampled (linear for positions and angles,
+    /// slerp for the root and ball joints). Default: the source's rate.
+    #[arg(long, value_name = "HZ")]
+    pub fps: Option<f64>,
+    /// Reproduce GMR exactly (its solver and targets: no planted feet, no ground,
+    /// self-collision or joint-speed constraints). Default: the physically plausible solve.
+    #[arg(long)]
+    pub gmr: bool,
     /// Split clips longer than this many frames into chunks solved in parallel (each warm-
-    /// started from a lead-in; on LAFAN1 the result equals the serial solve to ~1e-9 rad).
+    /// started from a lead-in; on the LAFAN1 walk the result equals the serial solve to
+    /// 3.7e-10 rad with --gmr, 1.1e-4 rad with the default solve).
     #[arg(long, value_name = "FRAMES")]
     pub chunk_frames: Option<usize>,
     /// Frames solved before each chunk and thrown away, so that its seam is smooth.
@@ -67,11 +80,20 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     if !input.is_dir() {
         bail!("{}: not a directory", input.display());
     }
-    let mut job = Job::load(&robot, args.config.as_deref(), args.human_height, &args.format)?;
-    if let Some(frames) = args.chunk_frames {
-        job.options.chunk = Some(retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in });
+    if let Some(fps) = args.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
+        bail!("--fps {fps}: expected a positive rate");
     }
-    let files = batch::select_shard(batch::walk(&input, &["bvh"])?, args.shard);
+    let options = RetargetOptions {
+        human_height: args.human_height,
+        chunk: args
+            .chunk_frames
+            .map(|frames| retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in }),
+        mode: if args.gmr { retarget::SolveMode::Gmr } else { retarget::SolveMode::default() },
+        ..RetargetOptions::default()
+    };
+    let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;
+    job.fps = args.fps;
+    let files = batch::select_shard(batch::walk(&input, &["bvh", "c3d"])?, args.shard);
     let jobs =
         args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     eprintln!(
@@ -124,36 +146,43 @@ fn print_table(summary: &Summary) {
     }
 }
 
-/// What every clip of a batch shares: the robot, the config source and the options.
+/// What every clip of a batch shares: the retargeter (robot, config choice, options) and
+/// the output settings.
 struct Job {
-    model: mjcf::Model,
-    robot: String,
+    retargeter: Retargeter,
     /// `--config`, read once.
     given: Option<IkConfig>,
-    /// The shipped robot's tuned config.
-    tuned: Option<IkConfig>,
-    options: RetargetOptions,
+    /// The marker part of `--config`, when it has one (needed by C3D clips).
+    markers: Option<MarkerConfig>,
+    config_path: Option<PathBuf>,
     format: Format,
+    /// `--fps`: resample every output.
+    fps: Option<f64>,
 }
 
 impl Job {
     fn load(
         robot: &str,
         config: Option<&Path>,
-        human_height: Option<f64>,
+        options: RetargetOptions,
         format: &str,
     ) -> anyhow::Result<Job> {
         let given = config.map(IkConfig::from_file).transpose()?;
-        let tuned = crate::cmd_retarget::shipped_config(robot).transpose()?;
         let format = crate::cmd_retarget::parse_format(Some(format))?
             .context("an output format is required")?;
+        let markers =
+            config.filter(|p| has_marker_bodies(p)).map(MarkerConfig::from_file).transpose()?;
+        let mut retargeter = Retargeter::new(robot)?.with_options(options);
+        if let Some(given) = &given {
+            retargeter = retargeter.with_config(given.clone());
+        }
         Ok(Job {
-            model: crate::shipped::robot_model(robot)?,
-            robot: crate::cmd_retarget::robot_label(robot),
+            retargeter,
             given,
-            tuned,
-            options: RetargetOptions { human_height, ..RetargetOptions::default() },
+            markers,
+            config_path: config.map(Path::to_path_buf),
             format,
+            fps: None,
         })
     }
 
@@ -161,32 +190,78 @@ impl Job {
     /// what was inferred about the source.
     fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<ClipResult> {
         remove_stale_temporaries(dst);
-        let bvh = bvh::from_path(src)?;
-        let chosen = retarget::derive::choose(
-            &self.model,
-            &self.robot,
-            &bvh,
-            &self.options.fk,
-            self.given.clone(),
-            self.tuned.as_ref(),
-            false,
-        )
-        .with_context(|| format!("{}: choosing the IK config", src.display()))?;
-        let (motion, diag) =
-            retarget::retarget_bvh(&bvh, &self.model, &chosen.config, &self.options)
+        let is_c3d = src.extension().is_some_and(|e| e.eq_ignore_ascii_case("c3d"));
+        let (motion, diag, config) = if is_c3d {
+            self.convert_c3d(src)?
+        } else {
+            let bvh = bvh::from_path(src)?;
+            let chosen = self
+                .retargeter
+                .choose_config(&bvh)
+                .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+            let (motion, diag) = self
+                .retargeter
+                .retarget_bvh_with(&bvh, &chosen)
                 .with_context(|| format!("{}: retargeting", src.display()))?;
-        let quality = retarget::report::report(
-            &motion,
-            &self.model,
-            &retarget::report::ReportOptions::default(),
-        )?;
-        write_motion(dst, &motion, &self.model, Some(self.format))?;
+            (motion, diag, chosen.config)
+        };
+        let report_options = retarget::report::ReportOptions {
+            position_targets: Some(config.position_targets()),
+            ..retarget::report::ReportOptions::default()
+        };
+        let quality = self.retargeter.report(&motion, &report_options)?;
+        let model = self.retargeter.model();
+        match self.fps {
+            Some(fps) => {
+                let resampled = retarget::resample::resample(&motion, model, fps)?;
+                write_motion(dst, &resampled, model, Some(self.format))?;
+            }
+            None => write_motion(dst, &motion, model, Some(self.format))?,
+        }
         Ok(ClipResult {
             frames: motion.num_frames(),
             metrics: serde_json::to_value(&quality)?,
-            inferred: Some(crate::cmd_retarget::with_config(&diag.human_inferred, &chosen.summary)),
+            inferred: Some(diag.human_inferred),
         })
     }
+}
+
+impl Job {
+    /// A C3D clip through the marker config's virtual bodies (as the main command's `--c3d`).
+    fn convert_c3d(
+        &self,
+        src: &Path,
+    ) -> anyhow::Result<(retarget::RobotMotion, retarget::ClipDiagnostics, IkConfig)> {
+        let Some(markers) = &self.markers else {
+            bail!(
+                "{}: a C3D clip needs a marker config: --config with `marker_bodies` (e.g. configs/c3d_plugingait_to_unitree_g1.json){}",
+                src.display(),
+                self.config_path
+                    .as_ref()
+                    .map_or(String::new(), |p| format!("; {} has none", p.display()))
+            );
+        };
+        let Some(config) = self.given.clone() else {
+            bail!("{}: a C3D clip needs --config (a marker config)", src.display());
+        };
+        let file = c3d::C3d::from_path(src).with_context(|| format!("{}", src.display()))?;
+        let name = src.display().to_string();
+        let clip = markers.motion(&file, &name, self.retargeter.options().human_height)?;
+        let (motion, mut diag) = self
+            .retargeter
+            .retarget_with(&clip.human, &config, clip.height)
+            .with_context(|| format!("{}: retargeting", src.display()))?;
+        diag.human_height_source = clip.height_source;
+        Ok((motion, diag, config))
+    }
+}
+
+/// Whether the JSON config at `path` has a `marker_bodies` table (a marker config).
+fn has_marker_bodies(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|json| json.get("marker_bodies").is_some())
 }
 
 /// A run killed while writing `dst` leaves `.<name>.tmp-*` beside it (the writers rename a

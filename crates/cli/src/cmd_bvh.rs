@@ -10,9 +10,13 @@ use clap::Subcommand;
 #[derive(Subcommand, Debug)]
 pub enum BvhCommand {
     /// Print a summary: frames, frame time, FPS, duration, joints as a tree, channels.
-    Info { file: PathBuf },
+    Info {
+        /// The BVH file.
+        file: PathBuf,
+    },
     /// Export as JSON: frame count, frame time and the joint tree with each joint's motion.
     Json {
+        /// The BVH file.
         file: PathBuf,
         /// Write here (atomically) instead of to standard output.
         #[arg(short, long)]
@@ -20,6 +24,7 @@ pub enum BvhCommand {
     },
     /// Parse and write back (shortest round-trip numbers): a normalised, checked copy.
     Cat {
+        /// The BVH file.
         file: PathBuf,
         /// Write here (atomically) instead of to standard output.
         #[arg(short, long)]

@@ -13,9 +13,13 @@ use serde_json::{json, Value};
 #[derive(Subcommand, Debug)]
 pub enum C3dCommand {
     /// Print header facts, points, analog channels, rate, events and parameter groups.
-    Info { file: PathBuf },
+    Info {
+        /// The C3D file.
+        file: PathBuf,
+    },
     /// Write marker positions, analog channels or events as CSV (default) or JSON.
     Dump {
+        /// The C3D file.
         file: PathBuf,
         #[command(flatten)]
         what: DumpWhat,
@@ -25,6 +29,7 @@ pub enum C3dCommand {
     },
     /// Rewrite a file as Intel data (the input's integer or float format unless told).
     Convert {
+        /// The C3D file to rewrite.
         file: PathBuf,
         /// Output .c3d file (written atomically).
         #[arg(short, long)]

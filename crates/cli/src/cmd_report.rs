@@ -18,6 +18,11 @@ pub struct ReportArgs {
     /// Robot (shipped name or MJCF path); default: the `robot` name stored in the .npz.
     #[arg(long)]
     pub robot: Option<String>,
+    /// The IK config the motion was solved with: bodies without a position weight get no
+    /// position error. Default: the shipped config of a shipped robot (else every target
+    /// body's position is measured).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<PathBuf>,
@@ -43,16 +48,23 @@ pub struct ReportArgs {
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     let motion = read_motion_npz(&args.motion)?;
-    let model = match &args.robot {
-        Some(robot) => shipped::robot_model(robot)?,
+    let (model, robot_arg) = match &args.robot {
+        Some(robot) => (shipped::robot_model(robot)?, robot.clone()),
         None => {
             let stored = read_npz_robot(&args.motion)?.with_context(|| {
                 format!("{}: no robot name stored; pass --robot", args.motion.display())
             })?;
-            shipped::robot_model(&stored).with_context(|| {
+            let model = shipped::robot_model(&stored).with_context(|| {
                 format!("{}: stored robot \"{stored}\"; pass --robot", args.motion.display())
-            })?
+            })?;
+            (model, stored)
         }
+    };
+    let position_targets = match &args.config {
+        Some(path) => Some(retarget::IkConfig::from_file(path)?.position_targets()),
+        None => crate::cmd_retarget::shipped_config(&robot_arg)
+            .transpose()?
+            .map(|c| c.position_targets()),
     };
     let robot = if model.name.is_empty() { "(unnamed)" } else { model.name.as_str() };
     let opts = ReportOptions {
@@ -62,6 +74,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         contact_speed: args.contact_speed,
         slide_speed: args.slide_speed,
         joint_velocity_limit: args.velocity_limit,
+        position_targets,
         ..ReportOptions::default()
     };
     let rep = report(&motion, &model, &opts)

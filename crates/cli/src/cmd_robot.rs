@@ -13,7 +13,10 @@ use crate::shipped;
 pub enum RobotCommand {
     /// Print joints, ranges and bodies of a robot (shipped name, MJCF or URDF path), and
     /// which body plays each role of the canonical humanoid (and the rule that decided it).
-    Info { robot: String },
+    Info {
+        /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
+        robot: String,
+    },
     /// Write the IK config derived for a robot (GMR schema): against the canonical human,
     /// with role names as human joints (bound to each skeleton when used with --config), or
     /// against the skeleton of --bvh, with its joint names.
@@ -30,6 +33,7 @@ pub enum RobotCommand {
     /// Compare our kinematics with MuJoCo's at random configurations (needs the `mujoco`
     /// feature): model structure, body poses and body Jacobians.
     Check {
+        /// A shipped robot (see `retarget robots`) or an MJCF (.xml) or URDF (.urdf) file.
         robot: String,
         /// Number of random configurations (checked in addition to qpos0).
         #[arg(long, default_value_t = 100)]

@@ -37,5 +37,10 @@ mod tests {
     fn unknown_names_list_the_shipped_robots() {
         let message = robot_model("no_such_robot").unwrap_err().to_string();
         assert!(message.contains("unitree_g1"), "{message}");
+        assert!(!message.contains("did you mean"), "nothing is near: {message}");
+        let message = robot_model("unitre_g1").unwrap_err().to_string();
+        assert!(message.ends_with("; did you mean unitree_g1?"), "{message}");
+        let message = robot_model("fourier").unwrap_err().to_string();
+        assert!(message.ends_with("; did you mean fourier_n1?"), "{message}");
     }
 }

@@ -171,7 +171,7 @@ fn bad_config_is_reported_with_its_position() {
 }
 
 #[test]
-fn fps_resamples_the_output_and_unknown_robots_are_errors() {
+fn fps_resamples_the_output_and_unknown_robots_are_named() {
     let dir = temp_dir("fps");
     if let Some(bvh) = short_walk(&dir, 31) {
         let csv = dir.join("walk60.csv");
@@ -185,10 +185,26 @@ fn fps_resamples_the_output_and_unknown_robots_are_errors() {
         assert_eq!(bad.status.code(), Some(1));
         assert!(text(&bad).1.contains("--fps"), "{}", text(&bad).1);
     }
-    let out = retarget(&["--bvh", "x.bvh", "--robot", "no_such_robot", "--config", "c.json"]);
-    assert_eq!(out.status.code(), Some(1));
+    // An unknown robot is reported by the robot lookup (with a config that exists, so the
+    // config cannot be what fails): the shipped robots are listed, the nearest name offered.
+    let config =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+    for extra in [&["--config", config.to_str().unwrap()][..], &[]] {
+        let args = [&["--bvh", "x.bvh", "--robot", "no_such_robot"][..], extra].concat();
+        let out = retarget(&args);
+        assert_eq!(out.status.code(), Some(1));
+        let stderr = text(&out).1;
+        assert!(
+            stderr.starts_with("error: unknown robot \"no_such_robot\": not a shipped robot (booster_t1_29dof, engineai_pm01, fourier_n1, stanford_toddy, unitree_g1, unitree_h1"),
+            "{extra:?}: {stderr}"
+        );
+        assert!(!stderr.contains("did you mean"), "{stderr}");
+    }
+    let out = retarget(&["--bvh", "x.bvh", "--robot", "unitre_g1"]);
+    assert!(text(&out).1.trim_end().ends_with("; did you mean unitree_g1?"), "{}", text(&out).1);
     let out = retarget(&["--bvh", "x.bvh"]);
     assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).1.contains("--robot <ROBOT>"), "{}", text(&out).1);
 }
 
 /// The G1 URDF (shared reference) as `--robot`, with the G1's LAFAN1 config: its body names

@@ -328,10 +328,10 @@ pub fn normalise(name: &str) -> String {
     let bytes = name.as_bytes();
     if rest.len() == lower.len()
         && bytes.len() > 2
-        && bytes[0] == b'j'
-        && bytes[1].is_ascii_uppercase()
+        && bytes.first() == Some(&b'j')
+        && bytes.get(1).is_some_and(u8::is_ascii_uppercase)
     {
-        rest = &rest[1..];
+        rest = rest.get(1..).unwrap_or(rest);
     }
     rest.chars().filter(char::is_ascii_alphanumeric).collect()
 }
@@ -425,7 +425,7 @@ fn words(name: &str) -> Vec<String> {
             }
             continue;
         }
-        let prev = i.checked_sub(1).map(|p| chars[p]);
+        let prev = i.checked_sub(1).and_then(|p| chars.get(p)).copied();
         let next = chars.get(i + 1).copied();
         let boundary = c.is_ascii_uppercase()
             && prev.is_some_and(|p| {

@@ -33,6 +33,21 @@ pub enum Error {
     /// NaN or infinity in the motion data.
     #[error("frame {frame}: channel {channel} of joint `{joint}` is {value}")]
     NonFinite { frame: usize, joint: String, channel: String, value: f64 },
+    /// A motion with no frames: nothing to retarget.
+    #[error("the motion has no frames")]
+    NoFrames,
+    /// A [`crate::HumanMotion`] whose pose arrays do not match its frames and bodies.
+    #[error("human motion holds {positions} positions and {orientations} orientations, expected {num_frames} frames × {num_bodies} bodies")]
+    BodyShape { positions: usize, orientations: usize, num_frames: usize, num_bodies: usize },
+    /// NaN or infinity in a computed world pose.
+    #[error("frame {frame}: the pose of body `{body}` is not finite")]
+    NonFinitePose { frame: usize, body: String },
+    /// A body absurdly far from the origin ([`crate::MAX_DISTANCE`]).
+    #[error("frame {frame}: body `{body}` is {distance:.3e} m from the origin (more than {} km): a corrupt value or a wrong unit", crate::MAX_DISTANCE / 1e3)]
+    AbsurdPosition { frame: usize, body: String, distance: f64 },
+    /// A body moving absurdly far in one frame ([`crate::MAX_STEP`]).
+    #[error("frame {frame}: body `{body}` moves {step:.3e} m since the previous frame (more than {} m): a corrupt value or a wrong unit", crate::MAX_STEP)]
+    AbsurdStep { frame: usize, body: String, step: f64 },
     #[error("the OFFSET of joint `{0}` is not finite")]
     NonFiniteOffset(String),
     /// A scale or height option that is zero, negative or not finite.

@@ -7,6 +7,12 @@
 //! `q = q_parent ⊗ q_local`, `p = q_parent · p_local + p_parent` (a [`PositionReading::World`]
 //! joint: `p = p_local`). World: `p' = R_axes · p · metres_per_unit`, `q' = q_axes ⊗ q`.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: Every index in this module is established by `Plan::new`, which checks the skeleton (parents before
+// children, channel columns inside the motion row) before anything is computed: `q`/`p` hold one
+// entry per joint, rows one value per column. This is the per-frame hot loop (the fk benchmark),
+// so it indexes instead of re-checking each access.
+#![allow(clippy::indexing_slicing)]
+
 use bvh::{Axis, Bvh, Channel, JointKind};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 

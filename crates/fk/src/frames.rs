@@ -55,8 +55,9 @@ pub fn canonical_frames(
     let trunk = [Role::Pelvis, Role::Spine, Role::Chest, Role::Neck, Role::Head];
     for (i, &role) in trunk.iter().enumerate().skip(1) {
         let Some(p) = at(role) else { continue };
-        let above = trunk[i + 1..].iter().find_map(|&r| at(r));
-        let below = trunk[..i].iter().rev().find_map(|&r| at(r));
+        let (lower, upper) = trunk.split_at(i);
+        let above = upper.iter().skip(1).find_map(|&r| at(r));
+        let below = lower.iter().rev().find_map(|&r| at(r));
         let z = match (above, below) {
             (Some(a), _) => unit(a - p, body.size),
             (None, Some(b)) => unit(p - b, body.size),
@@ -72,14 +73,16 @@ pub fn canonical_frames(
         }
     }
     for side in [Side::Left, Side::Right] {
-        let role = |part| Role::new(part, Some(side)).expect("sided part");
+        // Every part of these chains has sides, so `Role::new` finds each role.
+        let role = |part| Role::new(part, Some(side));
         let chains: [&[Part]; 2] = [
             &[Part::Clavicle, Part::UpperArm, Part::Forearm, Part::Hand],
             &[Part::Thigh, Part::Shin, Part::Foot],
         ];
         for chain in chains {
             for w in chain.windows(2) {
-                let (joint, child) = (role(w[0]), role(w[1]));
+                let &[a, b] = w else { continue };
+                let (Some(joint), Some(child)) = (role(a), role(b)) else { continue };
                 if let (Some(p), Some(c)) = (at(joint), at(child)) {
                     if let Some(r) = unit(p - c, body.size).and_then(|z| body.limb_frame(z)) {
                         out.insert(joint, r);
@@ -87,13 +90,17 @@ pub fn canonical_frames(
                 }
             }
         }
-        if let Some(&forearm) = out.get(&role(Part::Forearm)) {
-            if at(role(Part::Hand)).is_some() {
-                out.insert(role(Part::Hand), forearm);
+        let parts = [Part::Forearm, Part::Hand, Part::Foot, Part::Toe].map(role);
+        let [Some(forearm_role), Some(hand), Some(foot_role), Some(toe_role)] = parts else {
+            continue;
+        };
+        if let Some(&forearm) = out.get(&forearm_role) {
+            if at(hand).is_some() {
+                out.insert(hand, forearm);
             }
         }
-        let foot = at(role(Part::Foot));
-        let toe = at(role(Part::Toe));
+        let foot = at(foot_role);
+        let toe = at(toe_role);
         let heel_to_toe = match (foot, toe) {
             (Some(f), Some(t)) => unit(body.perpendicular(t - f), body.size),
             _ => None,
@@ -101,9 +108,9 @@ pub fn canonical_frames(
         .unwrap_or(body.forward);
         let up = unit(body.up - heel_to_toe * body.up.dot(&heel_to_toe), 1.0).unwrap_or(body.up);
         let r = body.rotation(heel_to_toe, up.cross(&heel_to_toe), up);
-        for part in [Part::Foot, Part::Toe] {
-            if at(role(part)).is_some() {
-                out.insert(role(part), r);
+        for part in [foot_role, toe_role] {
+            if at(part).is_some() {
+                out.insert(part, r);
             }
         }
     }

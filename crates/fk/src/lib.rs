@@ -24,6 +24,9 @@
 //!
 //! `fk` does no IO, never prints and never panics on input.
 
+// Library code never panics on input (issue 15): the compiler checks it. Tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 pub mod conventions;
 mod error;
 mod forward;
@@ -40,7 +43,7 @@ mod trig;
 pub use error::Error;
 pub use forward::{PositionChannels, PositionReading};
 pub use frames::canonical_frames;
-pub use motion::HumanMotion;
+pub use motion::{HumanMotion, MAX_DISTANCE, MAX_STEP};
 pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
 pub use roles::{
     Humanoid, Part, Reference, RestPose, Role, RoleJoint, RoleMap, Rule, Side, UpAxis,
@@ -143,16 +146,21 @@ fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
         .enumerate()
         .map(|(k, &f)| {
             let range = k * joints..(k + 1) * joints;
-            (f, positions[range.clone()].to_vec(), orientations[range].to_vec())
+            let p = positions.get(range.clone()).unwrap_or_default();
+            (f, p.to_vec(), orientations.get(range).unwrap_or_default().to_vec())
         })
         .collect();
     roles::Samples { rest: rest_pose(plan, &file), frames }
 }
 
 /// Forward kinematics of every frame of `bvh`, converted to our world (see [`FkOptions`]).
+/// A clip without frames, or whose poses are absurd ([`HumanMotion::validate`]), is an error.
 pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkReport), Error> {
     let plan = Plan::new(bvh)?;
     let fps = frames_per_second(bvh)?;
+    if bvh.motion.num_frames == 0 {
+        return Err(Error::NoFrames);
+    }
     check_finite(bvh)?;
     let joint_names: Vec<String> = bvh.skeleton.joints.iter().map(|j| j.name.clone()).collect();
     let derived = resolve_derived(&joint_names, &options.derived)?;
@@ -188,7 +196,11 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     };
     let rest = rest_pose(&plan, &world);
     let motion = HumanMotion { fps, body_names, num_frames, positions, orientations };
-    let frames = (0..num_frames).map(|f| &motion.frame_positions(f)[..num_joints]);
+    motion.validate()?;
+    let frames = (0..num_frames).map(|f| {
+        let all = motion.frame_positions(f);
+        all.get(..num_joints).unwrap_or(all)
+    });
     let stature = size::stature(frames, &rest, &landmarks);
     let (height, height_source) = match options.height {
         Some(h) => (h, "given".to_owned()),
@@ -244,9 +256,10 @@ fn check_finite(bvh: &Bvh) -> Result<(), Error> {
         frame,
         joint: joint.map(|j| j.name.clone()).unwrap_or_default(),
         channel: joint
-            .map(|j| j.channels[column - j.first_channel].name().to_owned())
+            .and_then(|j| j.channels.get(column - j.first_channel))
+            .map(|c| c.name().to_owned())
             .unwrap_or_default(),
-        value: motion.values[at],
+        value: motion.values.get(at).copied().unwrap_or(f64::NAN),
     })
 }
 
@@ -306,7 +319,7 @@ fn units(
         .offsets()
         .zip(&parents)
         .map(|(offset, parent)| match parent {
-            Some(p) if parents[*p].is_some() => Vector3::from(offset).norm(),
+            Some(p) if parents.get(*p).is_some_and(Option::is_some) => Vector3::from(offset).norm(),
             _ => 0.0,
         })
         .collect();
@@ -475,7 +488,9 @@ mod tests {
             let bvh = random_bvh(&mut rng, num_joints, 8);
             let options = FkOptions {
                 axes: axes[case % axes.len()],
-                units: UnitChoice::Scale([0.01, 1.0, 0.05644][case % 3]),
+                // Random channels in metres would teleport bodies by hundreds of metres per frame,
+                // which `HumanMotion::validate` rightly refuses: file units are cm, mm, CMU's.
+                units: UnitChoice::Scale([0.01, 0.001, 0.05644][case % 3]),
                 ..FkOptions::default()
             };
             let (motion, report) = human_motion(&bvh, &options).unwrap();

@@ -40,6 +40,12 @@ pub enum MarkerError {
     InvalidOption { name: &'static str, value: f64 },
     #[error("body `{body}`, frame {frame}: frame markers are collinear or coincide")]
     DegenerateFrame { body: String, frame: usize },
+    /// A marker absurdly far from the origin (more than [`crate::MAX_DISTANCE`] in metres).
+    #[error("frame {frame}: marker `{marker}` is {distance:.3e} m from the origin (more than {} km): a corrupt value or a wrong unit", crate::MAX_DISTANCE / 1e3)]
+    AbsurdMarker { frame: usize, marker: String, distance: f64 },
+    /// The virtual bodies' motion fails [`HumanMotion::validate`].
+    #[error(transparent)]
+    Motion(#[from] crate::Error),
 }
 
 /// The rotation taking a lab frame to ours (Z up): `"z-up"` (identity) or `"y-up"`
@@ -55,10 +61,12 @@ pub fn axes_rotation(name: &str) -> Option<UnitQuaternion<f64>> {
     }
 }
 
-/// Marker data converted to our world: per frame, per label, metres and Z up.
+/// Marker data converted to our world: per frame, per label, metres and Z up. Non-finite
+/// coordinates count as occluded; a finite one farther than [`crate::MAX_DISTANCE`] is an
+/// error naming the frame and marker.
 fn to_world(
     frames: &[Vec<Option<[f64; 3]>>],
-    num_labels: usize,
+    labels: &[String],
     metres_per_unit: f64,
     axes: &UnitQuaternion<f64>,
 ) -> Result<Vec<Vec<Option<Vector3<f64>>>>, MarkerError> {
@@ -69,16 +77,28 @@ fn to_world(
         .iter()
         .enumerate()
         .map(|(f, row)| {
-            if row.len() != num_labels {
-                return Err(MarkerError::Shape { frame: f, got: row.len(), expected: num_labels });
+            if row.len() != labels.len() {
+                return Err(MarkerError::Shape {
+                    frame: f,
+                    got: row.len(),
+                    expected: labels.len(),
+                });
             }
-            Ok(row
-                .iter()
-                .map(|p| {
-                    p.filter(|p| p.iter().all(|v| v.is_finite()))
-                        .map(|p| axes * (Vector3::from(p) * metres_per_unit))
+            row.iter()
+                .zip(labels)
+                .map(|(p, label)| {
+                    let Some(p) = p.filter(|p| p.iter().all(|v| v.is_finite())) else {
+                        return Ok(None);
+                    };
+                    let p = axes * (Vector3::from(p) * metres_per_unit);
+                    let distance = crate::motion::robust_norm(&p);
+                    if distance <= crate::MAX_DISTANCE {
+                        Ok(Some(p))
+                    } else {
+                        Err(MarkerError::AbsurdMarker { frame: f, marker: label.clone(), distance })
+                    }
                 })
-                .collect())
+                .collect()
         })
         .collect()
 }
@@ -86,24 +106,24 @@ fn to_world(
 /// Fills the gaps of a per-frame series linearly; holds the first/last value at the ends.
 /// `None` if no frame has a value.
 fn fill_gaps(series: &[Option<Vector3<f64>>]) -> Option<Vec<Vector3<f64>>> {
-    let known: Vec<usize> = (0..series.len()).filter(|&f| series[f].is_some()).collect();
-    let (&first, &last) = (known.first()?, known.last()?);
+    let known: Vec<(usize, Vector3<f64>)> =
+        series.iter().enumerate().filter_map(|(f, v)| Some((f, (*v)?))).collect();
+    let (&(first, at_first), &(last, at_last)) = (known.first()?, known.last()?);
     let mut out = Vec::with_capacity(series.len());
     let mut next = 0; // index into `known` of the first known frame >= f
-    for f in 0..series.len() {
-        while known[next] < f && next + 1 < known.len() {
+    for (f, value) in series.iter().enumerate() {
+        while known.get(next).is_some_and(|&(k, _)| k < f) && next + 1 < known.len() {
             next += 1;
         }
-        let v = if let Some(v) = series[f] {
-            v
-        } else if f < first {
-            series[first].unwrap_or_default()
-        } else if f > last {
-            series[last].unwrap_or_default()
-        } else {
-            let (b, a) = (known[next], known[next - 1]);
-            let t = (f - a) as f64 / (b - a) as f64;
-            series[a].unwrap_or_default() * (1.0 - t) + series[b].unwrap_or_default() * t
+        let v = match (value, known.get(next.wrapping_sub(1)), known.get(next)) {
+            (Some(v), _, _) => *v,
+            (None, _, _) if f < first => at_first,
+            (None, _, _) if f > last => at_last,
+            (None, Some(&(a, va)), Some(&(b, vb))) => {
+                let t = (f - a) as f64 / (b - a) as f64;
+                va * (1.0 - t) + vb * t
+            }
+            (None, _, _) => at_last,
         };
         out.push(v);
     }
@@ -119,6 +139,7 @@ fn find(labels: &[String], body: &str, marker: &str) -> Result<usize, MarkerErro
 
 /// Builds the virtual bodies' motion. `frames[f][p]` is marker `labels[p]` at frame `f`
 /// (file units, lab axes; `None` when occluded). Orientations are made continuous in time.
+/// Absurd marker positions and body motions are errors ([`HumanMotion::validate`]).
 pub fn marker_motion(
     labels: &[String],
     frames: &[Vec<Option<[f64; 3]>>],
@@ -133,7 +154,7 @@ pub fn marker_motion(
     if frames.is_empty() {
         return Err(MarkerError::NoFrames);
     }
-    let world = to_world(frames, labels.len(), metres_per_unit, axes)?;
+    let world = to_world(frames, labels, metres_per_unit, axes)?;
     let nf = frames.len();
     let nb = bodies.len();
     let mut positions = vec![Vector3::zeros(); nf * nb];
@@ -147,30 +168,35 @@ pub fn marker_motion(
         let centroid: Vec<Option<Vector3<f64>>> = world
             .iter()
             .map(|row| {
-                let present: Vec<Vector3<f64>> = idx.iter().filter_map(|&i| row[i]).collect();
+                let present: Vec<Vector3<f64>> =
+                    idx.iter().filter_map(|&i| row.get(i).copied().flatten()).collect();
                 (!present.is_empty())
                     .then(|| present.iter().sum::<Vector3<f64>>() / present.len() as f64)
             })
             .collect();
         let filled = fill_gaps(&centroid)
             .ok_or_else(|| MarkerError::NeverSeen { body: body.name.clone() })?;
-        for (f, p) in filled.into_iter().enumerate() {
-            positions[f * nb + b] = p;
+        for (slot, p) in positions.iter_mut().skip(b).step_by(nb).zip(filled) {
+            *slot = p;
         }
         let Some(frame) = &body.frame else { continue };
-        let mut tracks = Vec::with_capacity(3);
+        let mut tracks: Vec<Vec<Vector3<f64>>> = Vec::with_capacity(3);
         for m in frame {
             let i = find(labels, &body.name, m)?;
-            let series: Vec<Option<Vector3<f64>>> = world.iter().map(|row| row[i]).collect();
+            let series: Vec<Option<Vector3<f64>>> =
+                world.iter().map(|row| row.get(i).copied().flatten()).collect();
             tracks.push(fill_gaps(&series).ok_or_else(|| MarkerError::FrameMarkerNeverSeen {
                 body: body.name.clone(),
                 marker: m.clone(),
             })?);
         }
+        let [ta, tb, tc] = tracks.as_slice() else { continue };
         let mut previous: Option<UnitQuaternion<f64>> = None;
-        for f in 0..nf {
-            let q = triad(&tracks[0][f], &tracks[1][f], &tracks[2][f]).ok_or_else(|| {
-                MarkerError::DegenerateFrame { body: body.name.clone(), frame: f }
+        let slots = orientations.iter_mut().skip(b).step_by(nb);
+        for (f, (((a, bb), c), slot)) in ta.iter().zip(tb).zip(tc).zip(slots).enumerate() {
+            let q = triad(a, bb, c).ok_or_else(|| MarkerError::DegenerateFrame {
+                body: body.name.clone(),
+                frame: f,
             })?;
             let q = match previous {
                 Some(p) if p.coords.dot(&q.coords) < 0.0 => {
@@ -178,17 +204,19 @@ pub fn marker_motion(
                 }
                 _ => q,
             };
-            orientations[f * nb + b] = q;
+            *slot = q;
             previous = Some(q);
         }
     }
-    Ok(HumanMotion {
+    let motion = HumanMotion {
         fps,
         body_names: bodies.iter().map(|b| b.name.clone()).collect(),
         num_frames: nf,
         positions,
         orientations,
-    })
+    };
+    motion.validate()?;
+    Ok(motion)
 }
 
 /// The orientation of the triad `a b c` (module docs); `None` when degenerate.
@@ -213,25 +241,32 @@ pub fn marker_height(
     top: &[String],
     bottom: &[String],
 ) -> Result<Option<f64>, MarkerError> {
-    let world = to_world(frames, labels.len(), metres_per_unit, axes)?;
+    let world = to_world(frames, labels, metres_per_unit, axes)?;
     let top: Vec<usize> =
         top.iter().map(|m| find(labels, "height", m)).collect::<Result<_, _>>()?;
     let bottom: Vec<usize> =
         bottom.iter().map(|m| find(labels, "height", m)).collect::<Result<_, _>>()?;
     let mut tops: Vec<f64> = world
         .iter()
-        .filter_map(|row| top.iter().filter_map(|&i| row[i].map(|p| p.z)).reduce(f64::max))
+        .filter_map(|row| {
+            top.iter().filter_map(|&i| row.get(i).copied().flatten().map(|p| p.z)).reduce(f64::max)
+        })
         .collect();
     let floor = world
         .iter()
-        .filter_map(|row| bottom.iter().filter_map(|&i| row[i].map(|p| p.z)).reduce(f64::min))
+        .filter_map(|row| {
+            bottom
+                .iter()
+                .filter_map(|&i| row.get(i).copied().flatten().map(|p| p.z))
+                .reduce(f64::min)
+        })
         .reduce(f64::min);
     let Some(floor) = floor else { return Ok(None) };
     if tops.is_empty() {
         return Ok(None);
     }
     tops.sort_by(f64::total_cmp);
-    Ok(Some(tops[tops.len() / 2] - floor))
+    Ok(tops.get(tops.len() / 2).map(|top| top - floor))
 }
 
 #[cfg(test)]
@@ -293,6 +328,33 @@ mod tests {
             marker_motion(&l, &never, 100.0, 0.001, &id, &only_a),
             Err(MarkerError::NeverSeen { .. })
         ));
+    }
+
+    #[test]
+    fn absurd_markers_and_jumps_are_errors_naming_the_frame() {
+        let l = labels(&["A", "B"]);
+        let id = UnitQuaternion::identity();
+        let bodies = vec![MarkerBody { name: "AB".into(), markers: l.clone(), frame: None }];
+        let mut frames = vec![vec![Some([0.0, 0.0, 1000.0]), Some([100.0, 0.0, 1000.0])]; 4];
+        assert!(marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).is_ok());
+        // 1e300 mm: a corrupt number, named with its frame and marker.
+        frames[2][1] = Some([1e300, 0.0, 0.0]);
+        let err = marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).unwrap_err();
+        assert!(
+            matches!(&err, MarkerError::AbsurdMarker { frame: 2, marker, .. } if marker == "B"),
+            "{err:?}"
+        );
+        assert!(err.to_string().starts_with("frame 2: marker `B` is 1.000e297 m"), "{err}");
+        // 1 km in one frame (within the distance bound): the body's motion is refused.
+        frames[2][1] = Some([2e6, 0.0, 1000.0]);
+        let err = marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).unwrap_err();
+        assert!(
+            matches!(&err, MarkerError::Motion(crate::Error::AbsurdStep { frame: 2, body, .. }) if body == "AB"),
+            "{err:?}"
+        );
+        // Non-finite values are occlusions, as before.
+        frames[2][1] = Some([f64::NAN, 0.0, 0.0]);
+        assert!(marker_motion(&l, &frames, 100.0, 0.001, &id, &bodies).is_ok());
     }
 
     #[test]

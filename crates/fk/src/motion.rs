@@ -4,6 +4,15 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::Error;
 
+/// Farthest a body may be from the origin (m) in a valid [`HumanMotion`]: 100 km, far beyond
+/// any capture volume or outdoor inertial recording, and far below the magnitudes (1e300, …)
+/// of a corrupt number. See [`HumanMotion::validate`].
+pub const MAX_DISTANCE: f64 = 1e5;
+
+/// Farthest a body may move between consecutive frames (m) in a valid [`HumanMotion`]:
+/// 100 m, i.e. 3 km/s at 30 fps, where a sprinter moves 0.4 m per frame.
+pub const MAX_STEP: f64 = 100.0;
+
 /// Forward kinematics of a whole clip: per frame, per body, world position (metres, Z up)
 /// and world orientation (continuous in time: consecutive frames never differ in sign).
 ///
@@ -42,25 +51,33 @@ impl HumanMotion {
 
     /// World position of `body` at `frame` (metres, Z up). Panics if either is out of range.
     #[must_use]
+    // A caller's out-of-range index is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn position(&self, frame: usize, body: usize) -> &Vector3<f64> {
         &self.positions[self.slot(frame, body)]
     }
 
     /// World orientation of `body` at `frame`. Panics if either is out of range.
     #[must_use]
+    // A caller's out-of-range index is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn orientation(&self, frame: usize, body: usize) -> &UnitQuaternion<f64> {
         &self.orientations[self.slot(frame, body)]
     }
 
-    /// All bodies' positions at `frame`, indexed by body.
+    /// All bodies' positions at `frame`, indexed by body. Panics if `frame` is out of range.
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn frame_positions(&self, frame: usize) -> &[Vector3<f64>] {
         let n = self.num_bodies();
         &self.positions[frame * n..(frame + 1) * n]
     }
 
-    /// All bodies' orientations at `frame`, indexed by body.
+    /// All bodies' orientations at `frame`, indexed by body. Panics if `frame` is out of range.
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn frame_orientations(&self, frame: usize) -> &[UnitQuaternion<f64>] {
         let n = self.num_bodies();
         &self.orientations[frame * n..(frame + 1) * n]
@@ -72,9 +89,137 @@ impl HumanMotion {
         self.num_frames.saturating_sub(1) as f64 / self.fps
     }
 
+    /// Checks that the motion is usable: it has frames, `positions` and `orientations` hold
+    /// `num_frames × num_bodies` entries, every position and orientation is finite, no body
+    /// is farther than [`MAX_DISTANCE`] from the origin, and none moves more than
+    /// [`MAX_STEP`] between consecutive frames. Such values are not motion capture but a
+    /// corrupt file or a wrong unit; the error names the first frame and body at fault.
+    pub fn validate(&self) -> Result<(), Error> {
+        let nb = self.num_bodies();
+        if self.num_frames == 0 {
+            return Err(Error::NoFrames);
+        }
+        let expected = self.num_frames.checked_mul(nb);
+        if expected != Some(self.positions.len()) || expected != Some(self.orientations.len()) {
+            return Err(Error::BodyShape {
+                positions: self.positions.len(),
+                orientations: self.orientations.len(),
+                num_frames: self.num_frames,
+                num_bodies: nb,
+            });
+        }
+        let body = |k: usize| self.body_names.get(k).cloned().unwrap_or_default();
+        let frames =
+            self.positions.chunks_exact(nb.max(1)).zip(self.orientations.chunks_exact(nb.max(1)));
+        // Squared norms on the common path (a finite square within the bound implies finite
+        // coordinates); the exact figures are computed only for the error message.
+        let (max_d2, max_s2) = (MAX_DISTANCE * MAX_DISTANCE, MAX_STEP * MAX_STEP);
+        let mut previous: Option<&[Vector3<f64>]> = None;
+        for (frame, (positions, orientations)) in frames.enumerate() {
+            for (k, (p, q)) in positions.iter().zip(orientations).enumerate() {
+                let before = previous.and_then(|before| before.get(k));
+                let step2 = before.map_or(0.0, |b| (p - b).norm_squared());
+                let fine = p.norm_squared() <= max_d2
+                    && step2 <= max_s2
+                    && q.coords.norm_squared().is_finite();
+                if !fine {
+                    return Err(pose_error(frame, body(k), p, q, before));
+                }
+            }
+            previous = Some(positions);
+        }
+        Ok(())
+    }
+
     fn slot(&self, frame: usize, body: usize) -> usize {
         let n = self.num_bodies();
         assert!(frame < self.num_frames && body < n, "frame {frame} body {body} out of range");
         frame * n + body
+    }
+}
+
+/// Why a pose failed [`HumanMotion::validate`]'s quick test.
+fn pose_error(
+    frame: usize,
+    body: String,
+    p: &Vector3<f64>,
+    q: &UnitQuaternion<f64>,
+    before: Option<&Vector3<f64>>,
+) -> Error {
+    if !(p.iter().all(|v| v.is_finite()) && q.coords.iter().all(|v| v.is_finite())) {
+        return Error::NonFinitePose { frame, body };
+    }
+    let distance = robust_norm(p);
+    if distance > MAX_DISTANCE {
+        return Error::AbsurdPosition { frame, body, distance };
+    }
+    let step = before.map_or(0.0, |b| robust_norm(&(p - b)));
+    Error::AbsurdStep { frame, body, step }
+}
+
+/// `‖p‖` without overflow for huge finite coordinates (1e300² is infinite).
+pub(crate) fn robust_norm(p: &Vector3<f64>) -> f64 {
+    let m = p.amax();
+    if m > 0.0 {
+        m * (p / m).norm()
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn motion(frames: usize) -> HumanMotion {
+        let positions = (0..frames)
+            .flat_map(|f| [Vector3::new(0.01 * f as f64, 0.0, 1.0), Vector3::new(0.0, 0.1, 0.0)])
+            .collect();
+        HumanMotion {
+            fps: 30.0,
+            body_names: vec!["Hips".to_owned(), "LeftFoot".to_owned()],
+            num_frames: frames,
+            positions,
+            orientations: vec![UnitQuaternion::identity(); 2 * frames],
+        }
+    }
+
+    #[test]
+    fn validation_names_the_frame_and_body_at_fault() {
+        assert_eq!(motion(5).validate(), Ok(()));
+        assert_eq!(motion(0).validate(), Err(Error::NoFrames));
+        let mut m = motion(5);
+        m.positions.pop();
+        assert!(matches!(m.validate(), Err(Error::BodyShape { positions: 9, .. })));
+
+        let mut m = motion(5);
+        m.positions[2 * 3].x = 1e300;
+        let err = m.validate().unwrap_err();
+        assert!(
+            matches!(&err, Error::AbsurdPosition { frame: 3, body, .. } if body == "Hips"),
+            "{err:?}"
+        );
+        assert!(err.to_string().starts_with("frame 3: body `Hips` is 1.000e300 m"), "{err}");
+
+        // Kilometres in one frame, still within the distance bound.
+        let mut m = motion(5);
+        m.positions[2 * 4 + 1].y = 2000.0;
+        let err = m.validate().unwrap_err();
+        assert!(
+            matches!(&err, Error::AbsurdStep { frame: 4, body, step } if body == "LeftFoot" && *step > 1999.0),
+            "{err:?}"
+        );
+        // Just inside the step bound: fine.
+        let mut m = motion(2);
+        m.positions[3].y = 0.1 + MAX_STEP * 0.999;
+        assert_eq!(m.validate(), Ok(()));
+
+        let mut m = motion(5);
+        m.orientations[1] =
+            UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(f64::NAN, 0.0, 0.0, 0.0));
+        assert_eq!(
+            m.validate(),
+            Err(Error::NonFinitePose { frame: 0, body: "LeftFoot".to_owned() })
+        );
     }
 }

@@ -10,6 +10,11 @@
 //! A hand or foot may be an End Site when the skeleton has no joint there (Rigify's forearm
 //! ends at the wrist): its position is the wrist, its orientation the forearm's.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: Indices here are joint ids of a skeleton `Plan::new` has checked (every caller, `recognise`
+// and `human_motion`, builds the plan first: parents before children, ids < joint count), and
+// positions of per-joint arrays sized from that skeleton.
+#![allow(clippy::indexing_slicing)]
+
 use std::collections::BTreeMap;
 use std::fmt;
 

@@ -1,6 +1,10 @@
 //! How big the subject is: the unit guess (before FK), the subject height and the ground
 //! level (after FK, in metres).
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: Indices here are joint ids of a skeleton `Plan::new` has checked and positions in per-joint
+// arrays sized from it (rest pose, landmarks).
+#![allow(clippy::indexing_slicing)]
+
 /// Unit candidates, metres per file unit, with the name used in reports.
 const CANDIDATES: [(f64, &str); 5] = [
     (1.0, "metres"),

@@ -19,6 +19,10 @@
 //!   The joint at the end of the distal bone is the extremity (foot, hand) and, on legs, the
 //!   joint at the end of the next bone the toe.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: Indices here are joint ids of a skeleton `Plan::new` has checked (parents before children,
+// ids < joint count) and positions in per-joint arrays sized from it.
+#![allow(clippy::indexing_slicing)]
+
 use crate::conventions;
 
 /// Bones shorter than this fraction of the longest bone count as zero (joints at one point).

@@ -97,7 +97,10 @@ fn reduced_sin_cos(x: f64) -> (f64, f64) {
 /// `sin` and `cos` of half of every angle in `degrees` (converted as `f64::to_radians`), into
 /// `sin` and `cos`. One tight loop the compiler vectorizes, then a scalar pass for the rare
 /// huge or non-finite argument.
+#[allow(clippy::indexing_slicing)]
 pub(crate) fn half_angles_sin_cos(degrees: &[f64], sin: &mut [f64], cos: &mut [f64]) {
+    // Indexing within slices all cut to one length `n`: the compiler drops the bounds checks
+    // and vectorizes the first loop (the fk benchmark: iterator zips ran 25 % slower).
     let n = degrees.len().min(sin.len()).min(cos.len());
     let (values, sin, cos) = (&degrees[..n], &mut sin[..n], &mut cos[..n]);
     for i in 0..n {

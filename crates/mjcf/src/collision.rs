@@ -33,6 +33,10 @@
 //! capsule pairs, its native GJK/EPA for the rest); `mujoco_check` (feature `mujoco`) compares
 //! the two on every robot.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: indices are geom, body and weld ids the `Model` holds, and
+// arrays sized from it.
+#![allow(clippy::indexing_slicing)]
+
 use std::collections::BTreeSet;
 
 use nalgebra::{Matrix3, Unit, Vector3};

@@ -141,7 +141,7 @@ fn merge_geom(own: &GeomAttrs, base: &GeomAttrs) -> GeomAttrs {
     let size = match (&own.size, &base.size) {
         (Some(o), Some(b)) if o.len() < b.len() => {
             let mut merged = b.clone();
-            merged[..o.len()].copy_from_slice(o);
+            merged.iter_mut().zip(o).for_each(|(m, o)| *m = *o);
             Some(merged)
         }
         (o, b) => o.clone().or_else(|| b.clone()),
@@ -204,7 +204,8 @@ impl<'a> Compiler<'a> {
             dof_adr: self.model.nv,
             dof_num: 0,
         });
-        let parent_last_dof = if id == 0 { None } else { self.model.body_last_dof[parent] };
+        let parent_last_dof =
+            if id == 0 { None } else { self.model.body_last_dof.get(parent).copied().flatten() };
         self.model.body_last_dof.push(parent_last_dof);
         for (joint, frame_pos, class) in &contents.joints {
             if let Some(at) = frame_pos {
@@ -289,6 +290,8 @@ impl<'a> Compiler<'a> {
         }
     }
 
+    // `body` and its parent are ids this builder assigned (the body being compiled).
+    #[allow(clippy::indexing_slicing)]
     fn joint(&mut self, spec: &JointSpec, body: usize, class: &str) -> Result<(), Error> {
         let attrs = if spec.is_freejoint {
             spec.attrs.clone()
@@ -368,6 +371,8 @@ impl<'a> Compiler<'a> {
         Ok(Some(range))
     }
 
+    // `joint.body` is the body this builder is compiling.
+    #[allow(clippy::indexing_slicing)]
     fn push_qpos0(&mut self, joint: &Joint, attrs: &JointAttrs) {
         match joint.kind {
             JointType::Free => {
@@ -384,6 +389,8 @@ impl<'a> Compiler<'a> {
         self.model.nq += joint.kind.nq();
     }
 
+    // `joint.body` is the body this builder is compiling; `body_last_dof` has one entry per body.
+    #[allow(clippy::indexing_slicing)]
     fn push_dofs(&mut self, joint: &Joint) {
         let joint_id = self.model.joints.len();
         for _ in 0..joint.kind.nv() {
@@ -410,7 +417,7 @@ impl<'a> Compiler<'a> {
         let mut size = [0.0; 3];
         let default_size: &[f64] = if is_site { &[0.005, 0.005, 0.005] } else { &[0.0] };
         let given = attrs.size.as_deref().unwrap_or(default_size);
-        size[..given.len()].copy_from_slice(given);
+        size.iter_mut().zip(given).for_each(|(s, g)| *s = *g);
         let (pos, quat) = match attrs.fromto {
             Some(ft) => {
                 let (from, to) =

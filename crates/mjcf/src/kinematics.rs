@@ -2,6 +2,12 @@
 //! `mj_jac`/`mj_jacBody` and `mj_integratePos` (engine_core_smooth.c, engine_support.c),
 //! analytic and allocation-free.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: every index in this module is one `Model` itself holds
+// (parents before children, dof and qpos addresses inside nv and nq: the compilers build
+// them so), and `Data` is sized from the same model. This is the solver's per-iteration
+// hot loop (the kinematics benchmark), so it indexes instead of re-checking each access.
+#![allow(clippy::indexing_slicing)]
+
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::math::axis_angle;
@@ -240,6 +246,29 @@ impl Model {
                     jacp[r * nv + d] = v[r];
                     jacr[r * nv + d] = axis[r];
                 }
+            }
+        }
+    }
+
+    /// [`Model::jac`] at the origin of `body`, writing only the columns of the dofs on the
+    /// body's path to the world (the others keep what they held): for callers that read just
+    /// those columns ([`Model::body_dofs`]) and call it in a tight loop.
+    pub fn jac_chain(&self, data: &Data, body: usize, jacp: &mut [f64], jacr: &mut [f64]) {
+        let nv = self.nv;
+        let Some(point) = data.xpos.get(body).copied() else { return };
+        if jacp.len() < 3 * nv || jacr.len() < 3 * nv || data.dof_axis.len() != nv {
+            return;
+        }
+        for d in self.body_dofs(body) {
+            let axis = data.dof_axis[d];
+            let (p, r) = if data.dof_linear[d] {
+                (axis, Vector3::zeros())
+            } else {
+                (axis.cross(&(point - data.dof_anchor[d])), axis)
+            };
+            for k in 0..3 {
+                jacp[k * nv + d] = p[k];
+                jacr[k * nv + d] = r[k];
             }
         }
     }

@@ -25,6 +25,9 @@
 //! assert!((data.xpos[1].z - 1.0).abs() < 1e-15);
 //! ```
 
+// Library code never panics on input (issue 15): the compiler checks it. Tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 pub mod collision;
 mod compile;
 mod error;

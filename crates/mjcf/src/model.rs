@@ -207,11 +207,13 @@ impl Model {
     /// The dofs that move `body` (MuJoCo's dof ancestor chain), from the body towards the world.
     pub fn body_dofs(&self, body: usize) -> impl Iterator<Item = usize> + '_ {
         let start = self.body_last_dof.get(body).copied().flatten();
-        std::iter::successors(start, |&d| self.dof_parent[d])
+        std::iter::successors(start, |&d| self.dof_parent.get(d).copied().flatten())
     }
 
-    /// The joint a dof belongs to.
+    /// The joint a dof belongs to. Panics if `dof >= nv`.
     #[must_use]
+    // A caller's out-of-range dof is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn dof_joint(&self, dof: usize) -> usize {
         self.dof_joint[dof]
     }

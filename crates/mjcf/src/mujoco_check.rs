@@ -10,6 +10,11 @@
 //! loads a URDF as a moving body (`xml_urdf.cc`: `ROOT_free_joint` on the root link), then
 //! MuJoCo compiles it (static links fused as usual).
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: indices are ids of our `Model` and of MuJoCo's `mjModel` of
+// the same file, used only after the counts were compared; this module is a checker behind the
+// `mujoco` feature, not a reader of user input.
+#![allow(clippy::indexing_slicing)]
+
 use std::fmt;
 use std::path::Path;
 

@@ -12,6 +12,8 @@ impl Model {
     /// A random `qpos`: free joints at a random pose (x, y in [-2, 2], z in [0, 2], uniform
     /// orientation with w ≥ 0), ball joints at a uniform orientation, limited hinges and slides
     /// uniform in their range, unlimited hinges in [-π, π] and unlimited slides in [-1, 1].
+    // `qpos_adr` of each joint and its width lie inside `nq` by the model's construction.
+    #[allow(clippy::indexing_slicing)]
     pub fn random_qpos<R: Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
         let mut qpos = self.qpos0.clone();
         for joint in &self.joints {
@@ -39,6 +41,8 @@ impl Model {
 }
 
 /// Uniform random unit quaternion (normalised 4-D Gaussian, Box–Muller), w ≥ 0.
+// Constant indices into fixed-size arrays.
+#[allow(clippy::indexing_slicing)]
 fn random_quat<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
     loop {
         let mut q = [0.0; 4];

@@ -102,14 +102,10 @@ struct Loader {
 
 impl Loader {
     fn parse_file(&self, file: u32, sources: &mut Sources, depth: usize) -> Result<Element, Error> {
-        let text = sources.files[file as usize].1.clone();
+        let (name, text) = sources.files.get(file as usize).cloned().unwrap_or_default();
         let doc = roxmltree::Document::parse(&text).map_err(|e| {
             let p = e.pos();
-            let at = Location {
-                file: sources.files[file as usize].0.clone(),
-                line: p.row,
-                column: p.col,
-            };
+            let at = Location { file: name.clone(), line: p.row, column: p.col };
             Error::Xml { at, message: e.to_string() }
         })?;
         self.convert(doc.root_element(), file, sources, depth)

@@ -510,5 +510,8 @@ fn eulerseq(a: &Attr, src: &Sources) -> Result<[u8; 3], Error> {
             format!("eulerseq=\"{}\": expected three of x, y, z, X, Y, Z", a.value),
         ));
     }
-    Ok([bytes[0], bytes[1], bytes[2]])
+    match bytes {
+        &[a, b, c] => Ok([a, b, c]),
+        _ => Err(src.invalid(a.pos, "eulerseq: expected three axes")),
+    }
 }

@@ -38,6 +38,11 @@
 //! link gets a free joint named `ROOT_free_joint` (the name MuJoCo gives it when it loads a URDF
 //! as a moving body), unless the file has a `floating` joint already.
 
+// Exception to the crate's `deny(clippy::indexing_slicing)`, justified: indices are positions of links and joints in the parsed file's
+// own vectors (parent and child names resolved to them first; an unknown name is an error) and
+// body, joint and dof ids this builder assigned.
+#![allow(clippy::indexing_slicing)]
+
 use std::collections::{HashMap, HashSet};
 
 use nalgebra::{UnitQuaternion, Vector3};

@@ -36,19 +36,22 @@ fn reference_models(shared: &Path) -> Vec<(String, PathBuf)> {
     out
 }
 
-/// `robots/<key>/<key>.xml` of the repo, for the folders that exist.
+/// `robots/<key>/<key>.xml` of the repo. Every folder must hold its model and there must be
+/// at least the six robots we ship: a test over them can never pass by checking nothing.
 fn repo_models() -> Vec<(String, PathBuf)> {
-    let Ok(entries) = std::fs::read_dir(repo_root().join("robots")) else { return Vec::new() };
+    let entries = std::fs::read_dir(repo_root().join("robots")).expect("robots/ is readable");
     let mut out: Vec<(String, PathBuf)> = entries
         .filter_map(Result::ok)
         .filter(|e| e.path().is_dir())
-        .filter_map(|e| {
+        .map(|e| {
             let key = e.file_name().to_string_lossy().into_owned();
             let xml = e.path().join(format!("{key}.xml"));
-            xml.is_file().then_some((key, xml))
+            assert!(xml.is_file(), "robots/{key}/ has no {key}.xml");
+            (key, xml)
         })
         .collect();
     out.sort();
+    assert!(out.len() >= 6, "robots/ holds {} models, expected the 6 shipped ones", out.len());
     out
 }
 

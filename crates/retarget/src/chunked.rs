@@ -9,6 +9,9 @@
 //! serial solve (the IK is a local method whose result depends a little on its history);
 //! `tests/chunked.rs` measures it on the LAFAN1 walk.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::time::Instant;
 
 use fk::HumanMotion;

@@ -13,6 +13,9 @@
 //! serde_json; names that exist in neither the robot nor the human skeleton are reported by
 //! [`IkConfig::validate`] with the position of the name in the file and the nearest names.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::fmt;
 use std::path::Path;
 
@@ -177,6 +180,19 @@ impl IkConfig {
         out
     }
 
+    /// Robot bodies whose position is a target: a non-zero position weight in an enabled
+    /// table. The others are tracked for their orientation only.
+    #[must_use]
+    pub fn position_targets(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for e in self.stages().into_iter().flatten() {
+            if e.is_active() && e.pos_weight != 0.0 && !out.contains(&e.robot_body) {
+                out.push(e.robot_body.clone());
+            }
+        }
+        out
+    }
+
     /// Scale of a human body from the table (before the height ratio).
     #[must_use]
     pub fn scale_of(&self, human_body: &str) -> Option<f64> {
@@ -231,7 +247,7 @@ impl IkConfig {
                     ),
                 ));
             }
-            if let Some(other) = active[..i].iter().find(|o| o.human_body == e.human_body) {
+            if let Some(other) = active.iter().take(i).find(|o| o.human_body == e.human_body) {
                 return Err(self.invalid(
                     &e.robot_body,
                     format!(
@@ -345,15 +361,20 @@ fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+        // row[j] is the distance of a[..i] to b[..j]; `left` is the new row's previous entry.
+        let mut prev = i;
+        let mut left = i + 1;
+        for (slot, cb) in row.iter_mut().skip(1).zip(&b) {
+            let cur = *slot;
+            left = (prev + usize::from(ca != *cb)).min(left + 1).min(cur + 1);
+            *slot = left;
             prev = cur;
         }
+        if let Some(first) = row.first_mut() {
+            *first = i + 1;
+        }
     }
-    row[b.len()]
+    row.last().copied().unwrap_or(0)
 }
 
 #[cfg(test)]

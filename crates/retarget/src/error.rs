@@ -27,12 +27,14 @@ pub enum Error {
     /// A robot or human body name in a config that does not exist.
     #[error("{at}: unknown {side} body `{name}`{}", did_you_mean(nearest))]
     UnknownName { at: String, side: String, name: String, nearest: Vec<String> },
-    /// A robot argument that is neither a shipped robot nor a model file.
+    /// A robot argument that is neither a shipped robot nor a model file; `nearest` is the
+    /// shipped robot whose name is close, if one is.
     #[error(
-        "unknown robot \"{name}\": not a shipped robot ({}) and not an MJCF or URDF file",
-        shipped.join(", ")
+        "unknown robot \"{name}\": not a shipped robot ({}) nor an MJCF (.xml) or URDF (.urdf) file{}",
+        shipped.join(", "),
+        nearest.as_ref().map_or(String::new(), |k| format!("; did you mean {k}?"))
     )]
-    UnknownRobot { name: String, shipped: Vec<String> },
+    UnknownRobot { name: String, shipped: Vec<String>, nearest: Option<String> },
     /// An error about one input file, with its path.
     #[error("{path}: {source}")]
     InFile {

@@ -172,6 +172,19 @@ impl RobotFoot {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The toe point in the foot frame: the middle of the two foremost bottom corners of a
+    /// box sole (holosoma measures skating at a toe body), else the sole's lowest point at
+    /// rest.
+    #[must_use]
+    pub fn toe_point(&self) -> Vector3<f64> {
+        let mut corners = self.corners.clone();
+        corners.sort_by(|a, b| self.forward.dot(b).total_cmp(&self.forward.dot(a)));
+        match corners.as_slice() {
+            [a, b, ..] => (a + b) / 2.0,
+            _ => self.sole_low_point(&self.rest),
+        }
+    }
+
     /// The sole's lowest point for a body orientation `rot`, in the foot body's frame.
     #[must_use]
     pub fn sole_low_point(&self, rot: &UnitQuaternion<f64>) -> Vector3<f64> {

@@ -6,6 +6,12 @@
 //! Poses are `(w, x, y, z)` quaternion + translation, `Pose`. Tangent vectors are
 //! `[v; ω]`: translation part first.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+// Exception to `indexing_slicing`, justified: constant indices into fixed-size nalgebra vectors and matrices
+// (`Vector3`, `Vector6`, `Matrix3`, `Matrix6`): in range by their types.
+#![allow(clippy::indexing_slicing)]
+
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// mink's epsilon for `f64` (`get_epsilon`).

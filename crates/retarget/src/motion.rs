@@ -1,5 +1,8 @@
 //! The retargeter's output: robot configurations over time, plus what they tracked.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// The world targets the solver tracked, per frame and per target body.
@@ -45,8 +48,10 @@ impl RobotMotion {
         self.qpos.len().checked_div(self.nq).unwrap_or(0)
     }
 
-    /// One frame's configuration.
+    /// One frame's configuration. Panics if `index >= num_frames()`.
     #[must_use]
+    // A caller's out-of-range frame is a bug, like slice indexing (documented above).
+    #[allow(clippy::indexing_slicing)]
     pub fn frame(&self, index: usize) -> &[f64] {
         &self.qpos[index * self.nq..(index + 1) * self.nq]
     }

@@ -94,7 +94,7 @@ impl Default for PlausibleOptions {
             self_collision: SelfCollisionMode::On,
             smoothing_passes: 1,
             repair_weight: 1000.0,
-            repair_steps: 2,
+            repair_steps: 1,
             max_extra_steps: 10,
         }
     }
@@ -187,14 +187,12 @@ impl ClipDiagnostics {
     fn stats(&self, value: impl Fn(&FrameDiagnostics, usize) -> f64) -> Vec<(f64, f64)> {
         (0..self.body_names.len())
             .map(|k| {
-                let mut v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
+                let v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
                 if v.is_empty() {
                     return (0.0, 0.0);
                 }
                 let mean = v.iter().sum::<f64>() / v.len() as f64;
-                v.sort_by(f64::total_cmp);
-                let idx = ((v.len() as f64 - 1.0) * 0.95).round() as usize;
-                (mean, v[idx.min(v.len() - 1)])
+                (mean, crate::report::percentile(&v, 0.95))
             })
             .collect()
     }
@@ -271,6 +269,7 @@ impl<'a> Prepared<'a> {
         config: &IkConfig,
         options: &'a RetargetOptions,
     ) -> Result<Prepared<'a>, Error> {
+        human.validate()?;
         let height = options
             .human_height
             .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
@@ -279,13 +278,6 @@ impl<'a> Prepared<'a> {
         let stages = task_specs(config, model, &map);
         let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
         let (nb, nf) = (human.num_bodies(), human.num_frames);
-        if human.positions.len() != nf * nb || human.orientations.len() != nf * nb {
-            return Err(Error::InvalidOption(format!(
-                "human motion holds {} positions and {} orientations, expected {nf} frames × {nb} bodies",
-                human.positions.len(),
-                human.orientations.len()
-            )));
-        }
         let slots = map.bodies.len();
         let mut targets =
             vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
@@ -372,6 +364,11 @@ impl<'a> Prepared<'a> {
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
+        // With a repair pass, the first pass tracks with joint ranges and speed limits only
+        // (box bounds: the fast QP); the repair pass holds the ground and self-collision.
+        if passes > 0 {
+            solver.hold_constraints(false);
+        }
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt));
@@ -386,6 +383,7 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(p) = &self.options.mode {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
+                solver.hold_constraints(true);
                 solver.set_qpos(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;

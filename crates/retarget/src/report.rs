@@ -42,13 +42,16 @@
 //!   holosoma's `penetration_tolerance`, strict `>`); the **duration** is penetrating frames /
 //!   frames; the **max depth** is over all frames.
 //! - **Skating** (needs the source's foot contacts): a foot's speed at frame t is
-//!   `|xy[t] − xy[t−1]| · fps` of its body origin, 0 at frame 0 (holosoma: backward
+//!   `|xy[t] − xy[t−1]| · fps` of its toe point ([`crate::feet::RobotFoot::toe_point`]: the
+//!   middle of the sole's front bottom edge; the body origin when the foot has no collision
+//!   primitive), 0 at frame 0 (holosoma: backward
 //!   differences with a leading 0). A foot **skates** in a frame when the source foot is in
 //!   contact and its speed exceeds [`ReportOptions::skate_speed`] (0.3 m/s: holosoma's strict
 //!   threshold; its legacy one is 0.01 m per frame at its 30 fps). The **duration** is frames
 //!   with a skating foot / frames with a foot in source contact (holosoma counts frames, either
 //!   foot, not foot samples); the **max speed** is over skating samples. Holosoma tracks a toe
-//!   body (`*_ankle_roll_sphere_5_link` on its G1); we track the foot body.
+//!   body (`*_ankle_roll_sphere_5_link` on its G1, a sphere at the front of the sole); the toe
+//!   point is our equivalent on any robot (a foot rolling onto its toes keeps it still).
 //! - **Stance** (needs the source's foot contacts; not in holosoma): over the foot × frame
 //!   samples where the source foot is in contact, the share where the foot height `h` (above)
 //!   is above [`ReportOptions::stance_float_height`] (2 cm: **floating in stance**) and the
@@ -62,6 +65,13 @@
 //! - **Joint speed over limit**: per hinge or slide joint with a published
 //!   [`mjcf::Joint::velocity_limit`], frames × joints with `|q̇| > limit` (`q̇` as above) and the
 //!   largest `|q̇| / limit`; `None` when no joint has a limit.
+
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+// Exception to `indexing_slicing`, justified: `report` checks the motion against the model before anything
+// else (`check_motion`: nq, frames, names, target and contact lengths), so frame, joint,
+// body and geom indices come from that model and motion, never unchecked from a file.
+#![allow(clippy::indexing_slicing)]
 
 use std::fmt;
 
@@ -102,6 +112,10 @@ pub struct ReportOptions {
     pub sole_band: [f64; 2],
     /// Self-collision frames count pairs deeper than this (m). Default 0.01.
     pub self_collision_depth: f64,
+    /// Robot bodies whose position is a target (a non-zero position weight in the IK config:
+    /// [`crate::IkConfig::position_targets`]); the others get no position error. `None`:
+    /// every target body.
+    pub position_targets: Option<Vec<String>>,
 }
 
 impl Default for ReportOptions {
@@ -119,6 +133,7 @@ impl Default for ReportOptions {
             stance_float_height: 0.02,
             sole_band: [-0.005, 0.01],
             self_collision_depth: 0.01,
+            position_targets: None,
         }
     }
 }
@@ -135,8 +150,9 @@ pub struct Stats {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BodyTracking {
     pub body: String,
-    /// Position error (m).
-    pub pos_m: Stats,
+    /// Position error (m); `None` for a body whose position is not a target
+    /// ([`ReportOptions::position_targets`]).
+    pub pos_m: Option<Stats>,
     /// Rotation error (rad).
     pub rot_rad: Stats,
 }
@@ -345,13 +361,22 @@ pub fn report(
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
     let (ground_penetration, self_collision) = collisions(motion, model, opts);
-    let foot_xy = feet.map(|f| (0..frames).map(|t| poses.pos(t, f - 1).xy()).collect::<Vec<_>>());
+    // Skating is measured at the toe point of the sole (holosoma: a toe body), else at the
+    // foot body's origin.
+    let toe = feet.map(|f| {
+        crate::feet::RobotFoot::new(model, f, f, 0, None)
+            .map_or(nalgebra::Vector3::zeros(), |r| r.toe_point())
+    });
+    let foot_xy: [Vec<nalgebra::Vector2<f64>>; 2] = std::array::from_fn(|i| {
+        let b = feet[i] - 1;
+        (0..frames).map(|t| (poses.pos(t, b) + (poses.quat(t, b) * toe[i])).xy()).collect()
+    });
     let contacts = motion.contacts.as_ref().map(|c| [&c.left[..], &c.right[..]]);
     Ok(QualityReport {
         robot: model.name.clone(),
         frames,
         fps: motion.fps,
-        tracking: tracking(motion, model, &poses)?,
+        tracking: tracking(motion, model, &poses, opts.position_targets.as_deref())?,
         joint_limits: joint_limits(motion, model, opts.limit_tolerance),
         joints: joint_motion(motion, model, opts.joint_velocity_limit),
         feet: feet_reports,
@@ -663,6 +688,7 @@ fn tracking(
     motion: &RobotMotion,
     model: &mjcf::Model,
     poses: &BodyPoses,
+    position_targets: Option<&[String]>,
 ) -> Result<Option<Vec<BodyTracking>>, Error> {
     let Some(targets) = &motion.targets else { return Ok(None) };
     let k = targets.body_names.len();
@@ -674,7 +700,9 @@ fn tracking(
             pos.push((poses.pos(t, b) - targets.pos[t * k + j]).norm());
             rot.push(poses.quat(t, b).angle_to(&targets.quat[t * k + j]));
         }
-        out.push(BodyTracking { body: name.clone(), pos_m: stats(&pos), rot_rad: stats(&rot) });
+        let tracked = position_targets.is_none_or(|names| names.contains(name));
+        let pos_m = tracked.then(|| stats(&pos));
+        out.push(BodyTracking { body: name.clone(), pos_m, rot_rad: stats(&rot) });
     }
     Ok(Some(out))
 }
@@ -751,8 +779,10 @@ fn mean(x: &[f64]) -> f64 {
     }
 }
 
-/// numpy's `percentile(x, 100 p)` with linear interpolation; 0 for no data.
-fn percentile(x: &[f64], p: f64) -> f64 {
+/// numpy's `percentile(x, 100 p)` with linear interpolation; 0 for no data. The one rule of
+/// every percentile we print (the report, the main command's summary, batch summaries).
+#[must_use]
+pub fn percentile(x: &[f64], p: f64) -> f64 {
     if x.is_empty() {
         return 0.0;
     }
@@ -787,17 +817,23 @@ impl fmt::Display for QualityReport {
         if let Some(tracking) = &self.tracking {
             writeln!(f, "\ntracking error           position (cm) mean / p95 / max   rotation (rad) mean / p95 / max")?;
             for b in tracking {
-                let (p, r) = (b.pos_m, b.rot_rad);
+                let r = b.rot_rad;
+                // A body whose position is not a target gets dashes, as in the main command.
+                let p = b.pos_m.map_or_else(
+                    || format!("{:>7} {:>7} {:>7}", "-", "-", "-"),
+                    |p| {
+                        format!(
+                            "{:>7.2} {:>7.2} {:>7.2}",
+                            p.mean * 100.0,
+                            p.p95 * 100.0,
+                            p.max * 100.0
+                        )
+                    },
+                );
                 writeln!(
                     f,
-                    "  {:<24} {:>7.2} {:>7.2} {:>7.2}          {:>7.3} {:>7.3} {:>7.3}",
-                    b.body,
-                    p.mean * 100.0,
-                    p.p95 * 100.0,
-                    p.max * 100.0,
-                    r.mean,
-                    r.p95,
-                    r.max
+                    "  {:<24} {p}          {:>7.3} {:>7.3} {:>7.3}",
+                    b.body, r.mean, r.p95, r.max
                 )?;
             }
         }

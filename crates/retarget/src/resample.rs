@@ -6,6 +6,9 @@
 //! output frame is the last one at or before the source's last frame, so nothing is
 //! extrapolated.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use mjcf::{JointType, Model};
 use nalgebra::{Quaternion, UnitQuaternion};
 
@@ -45,7 +48,12 @@ pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMo
     let targets = motion.targets.as_ref().map(|t| resample_targets(t, &samples, frames));
     // A contact label is a state, not a quantity: take the nearer source frame's.
     let nearest = |v: &[bool]| -> Vec<bool> {
-        samples.iter().map(|&(i, a)| v[if a < 0.5 { i } else { (i + 1).min(frames - 1) }]).collect()
+        samples
+            .iter()
+            .map(|&(i, a)| {
+                v.get(if a < 0.5 { i } else { (i + 1).min(frames - 1) }).copied().unwrap_or(false)
+            })
+            .collect()
     };
     let contacts = motion
         .contacts
@@ -63,14 +71,23 @@ fn blend_qpos(model: &Model, a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
             JointType::Ball => joint.qpos_adr,
             JointType::Hinge | JointType::Slide => continue,
         };
-        let q = slerp(quat(&a[quat_at..quat_at + 4]), quat(&b[quat_at..quat_at + 4]), t);
-        out[quat_at..quat_at + 4].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        let (Some(qa), Some(qb)) = (a.get(quat_at..quat_at + 4), b.get(quat_at..quat_at + 4))
+        else {
+            continue;
+        };
+        let q = slerp(quat(qa), quat(qb), t);
+        if let Some(slot) = out.get_mut(quat_at..quat_at + 4) {
+            slot.copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        }
     }
     out
 }
 
 fn quat(wxyz: &[f64]) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_quaternion(Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]))
+    match wxyz {
+        &[w, x, y, z] => UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)),
+        _ => UnitQuaternion::identity(),
+    }
 }
 
 /// Slerp on the shorter arc (q and −q are the same rotation).
@@ -90,9 +107,16 @@ fn resample_targets(t: &TrackedTargets, samples: &[(usize, f64)], frames: usize)
     for &(i, a) in samples {
         let j = (i + 1).min(frames - 1);
         for b in 0..k {
-            let (p0, p1) = (t.pos[i * k + b], t.pos[j * k + b]);
+            let (Some(&p0), Some(&p1), Some(&q0), Some(&q1)) = (
+                t.pos.get(i * k + b),
+                t.pos.get(j * k + b),
+                t.quat.get(i * k + b),
+                t.quat.get(j * k + b),
+            ) else {
+                continue;
+            };
             pos.push(p0 + (p1 - p0) * a);
-            quat.push(slerp(t.quat[i * k + b], t.quat[j * k + b], a));
+            quat.push(slerp(q0, q1, a));
         }
     }
     TrackedTargets { body_names: t.body_names.clone(), pos, quat }

@@ -124,8 +124,7 @@ impl Retargeter {
     /// A shipped robot by key; an error for anything else.
     pub fn shipped(key: &str) -> Result<Retargeter, Error> {
         if shipped::find(key).is_none() {
-            let shipped = shipped::keys().map(str::to_owned).collect();
-            return Err(Error::UnknownRobot { name: key.to_owned(), shipped });
+            return Err(shipped::unknown_robot(key));
         }
         Retargeter::new(key)
     }

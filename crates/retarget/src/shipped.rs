@@ -100,10 +100,7 @@ pub fn load_robot(name_or_path: &str) -> Result<Model, Error> {
         return robot.model();
     }
     if !looks_like_path(name_or_path) {
-        return Err(Error::UnknownRobot {
-            name: name_or_path.to_owned(),
-            shipped: keys().map(str::to_owned).collect(),
-        });
+        return Err(unknown_robot(name_or_path));
     }
     let path = Path::new(name_or_path);
     let mut model = Model::from_path(path)?;
@@ -115,6 +112,22 @@ pub fn load_robot(name_or_path: &str) -> Result<Model, Error> {
         JointSpeedLimits::from_json_str(&text, &origin)?.apply(&mut model, &origin)?;
     }
     Ok(model)
+}
+
+/// [`Error::UnknownRobot`] for `name`: the shipped robots, and the nearest one by name when
+/// one is close (Jaro-Winkler similarity ≥ 0.7, as clap suggests subcommands).
+#[must_use]
+pub fn unknown_robot(name: &str) -> Error {
+    let nearest = keys()
+        .map(|k| (strsim::jaro_winkler(name, k), k))
+        .filter(|(score, _)| *score >= 0.7)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, k)| k.to_owned());
+    Error::UnknownRobot {
+        name: name.to_owned(),
+        shipped: keys().map(str::to_owned).collect(),
+        nearest,
+    }
 }
 
 /// Whether a robot argument names a model file rather than a shipped robot: an existing file,
@@ -162,6 +175,9 @@ mod tests {
     fn unknown_names_list_the_shipped_robots() {
         let message = load_robot("no_such_robot").unwrap_err().to_string();
         assert!(message.contains("unitree_g1"), "{message}");
+        assert!(!message.contains("did you mean"), "nothing is near: {message}");
+        let message = load_robot("unitre_g1").unwrap_err().to_string();
+        assert!(message.ends_with("; did you mean unitree_g1?"), "{message}");
         assert!(matches!(load_robot("no_such_robot"), Err(Error::UnknownRobot { .. })));
         assert!(matches!(load_robot("/no/such/robot.xml"), Err(Error::Mjcf(_))));
     }

@@ -148,6 +148,12 @@ pub struct Solver<'m> {
     /// Per dof: the speed limit of its joint (rad/s or m/s), if any.
     dof_speed: Vec<Option<f64>>,
     dense: DenseQp,
+    /// Dofs moving each body, ascending.
+    body_dofs: Vec<Vec<usize>>,
+    /// Scratch: a point task's Jacobian columns, plain and weighted.
+    point_cols: Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)>,
+    /// Whether the constraints are held ([`Solver::hold_constraints`]).
+    constraints_on: bool,
     /// This frame's point tasks ([`Solver::set_point_tasks`]).
     point_tasks: Vec<PointTask>,
     /// Whether a general row was active in the last dense solve (then the next step goes
@@ -223,6 +229,15 @@ impl<'m> Solver<'m> {
             dof_speed: vec![None; nv],
             dense: DenseQp::new(nv),
             point_tasks: Vec::new(),
+            body_dofs: (0..model.nbody())
+                .map(|b| {
+                    let mut d: Vec<usize> = model.body_dofs(b).collect();
+                    d.sort_unstable();
+                    d
+                })
+                .collect(),
+            point_cols: Vec::with_capacity(nv),
+            constraints_on: true,
             rows_bound: false,
             relaxed_steps: 0,
         };
@@ -235,6 +250,12 @@ impl<'m> Solver<'m> {
     /// speed limits), the later ones are dropped for that step first.
     pub fn add_constraint(&mut self, constraint: Box<dyn Constraint + 'm>) {
         self.constraints.push(constraint);
+    }
+
+    /// Whether the steps from now on hold the constraints added with
+    /// [`Solver::add_constraint`] (on by default; joint ranges and speed limits always hold).
+    pub fn hold_constraints(&mut self, on: bool) {
+        self.constraints_on = on;
     }
 
     /// Per-joint speed limits (indexed like `Model::joints`; rad/s or m/s), held as hard
@@ -369,15 +390,15 @@ impl<'m> Solver<'m> {
         for k in 0..self.stages[s].len() {
             mu_total += self.task_objective(s, k, targets);
         }
+        self.add_point_tasks();
         for d in 0..nv {
             self.qp.h[d * nv + d] += self.options.damping + mu_total;
             for e in 0..d {
                 self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
             }
         }
-        self.add_point_tasks();
         self.set_bounds(dt);
-        let status = if self.constraints.is_empty() {
+        let status = if self.constraints.is_empty() || !self.constraints_on {
             let status = self.qp.solve();
             self.dq.copy_from_slice(&self.qp.x);
             status
@@ -461,7 +482,7 @@ impl<'m> Solver<'m> {
         let body = task.spec.body;
         let frame = self.body_pose(body);
         let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &frame));
-        self.model.jac_body(&self.data, body, &mut self.jacp, &mut self.jacr);
+        self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
         let task = &mut self.stages[s][k];
         for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
@@ -487,24 +508,34 @@ impl<'m> Solver<'m> {
 
     /// `w² JᵀJ` into H and `−w² Jᵀ e` into c for each point task (`J`: the point's
     /// translational Jacobian, `e = target − p`).
+    /// Upper triangle only (dofs ascending; the caller mirrors H). Points on one body share
+    /// its Jacobian at the origin: a point `r` away moves by `J_p = J_o + J_ω × r`.
     fn add_point_tasks(&mut self) {
         let nv = self.model.nv;
-        for k in 0..self.point_tasks.len() {
-            let task = self.point_tasks[k];
-            let b = task.body;
-            let p = self.data.xpos[b] + self.data.xmat[b] * task.point;
-            let e = task.target - p;
-            self.model.jac(&self.data, b, &p, &mut self.jacp, &mut self.jacr);
-            let w2 = task.weight.component_mul(&task.weight);
-            let dofs: Vec<usize> = self.model.body_dofs(b).collect();
-            for &i in &dofs {
-                let ji = [self.jacp[i], self.jacp[nv + i], self.jacp[2 * nv + i]];
-                self.qp.c[i] -= w2.x * ji[0] * e.x + w2.y * ji[1] * e.y + w2.z * ji[2] * e.z;
-                for &j in &dofs {
-                    let jj = [self.jacp[j], self.jacp[nv + j], self.jacp[2 * nv + j]];
-                    self.qp.h[i * nv + j] +=
-                        w2.x * ji[0] * jj[0] + w2.y * ji[1] * jj[1] + w2.z * ji[2] * jj[2];
+        let mut k = 0;
+        while k < self.point_tasks.len() {
+            let b = self.point_tasks[k].body;
+            self.model.jac_chain(&self.data, b, &mut self.jacp, &mut self.jacr);
+            let dofs = &self.body_dofs[b];
+            let origin = self.data.xpos[b];
+            while let Some(task) = self.point_tasks.get(k).filter(|t| t.body == b) {
+                let r = self.data.xmat[b] * task.point;
+                let e = task.target - (origin + r);
+                let w2 = task.weight.component_mul(&task.weight);
+                self.point_cols.clear();
+                for &d in dofs {
+                    let col = |j: &[f64]| nalgebra::Vector3::new(j[d], j[nv + d], j[2 * nv + d]);
+                    let j = col(&self.jacp) + col(&self.jacr).cross(&r);
+                    self.point_cols.push((j, j.component_mul(&w2)));
                 }
+                for (a, (&da, (_, wa))) in dofs.iter().zip(&self.point_cols).enumerate() {
+                    self.qp.c[da] -= wa.dot(&e);
+                    let row = &mut self.qp.h[da * nv..(da + 1) * nv];
+                    for (&db, (jb, _)) in dofs[a..].iter().zip(&self.point_cols[a..]) {
+                        row[db] += wa.dot(jb);
+                    }
+                }
+                k += 1;
             }
         }
     }

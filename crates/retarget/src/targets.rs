@@ -16,6 +16,9 @@
 //! exactly as in GMR. A scaled body with no active table-1 entry (GMR raises `KeyError`)
 //! gets no offset here.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
@@ -98,7 +101,11 @@ impl TargetMap {
     }
 
     /// Targets of one frame: `positions`/`orientations` are all human bodies of the frame
-    /// (indexed like the motion), `out` gets one pose per scaled body.
+    /// (indexed like the motion), `out` gets one pose per scaled body. Panics if they hold
+    /// fewer bodies than the motion the map was made for.
+    // `bodies[..].human` index the motion's bodies the map was built from (`new` resolved them
+    // by name) and `root` indexes `bodies`: a shorter slice is a caller's bug.
+    #[allow(clippy::indexing_slicing)]
     pub fn compute(
         &self,
         positions: &[Vector3<f64>],

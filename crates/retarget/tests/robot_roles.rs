@@ -46,7 +46,10 @@ fn every_reference_robot_is_recognised() {
         let roles =
             RobotRoles::recognise(&model).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let what = path.display();
-        assert!((roles.forward - nalgebra::Vector3::x()).norm() < 1e-9, "{what}: {}", roles.facing);
+        // Forward is perpendicular to the hips' axis: within 1e-2 of +x, because kuavo_s45's
+        // two hips are 1.6 mrad off the y axis at qpos0.
+        let off = (roles.forward - nalgebra::Vector3::x()).norm();
+        assert!(off < 1e-2, "{what}: forward {:?} ({})", roles.forward, roles.facing);
         let point = |r: Role| roles.roles[&r].point;
         for (l, r) in
             [(Role::LeftThigh, Role::RightThigh), (Role::LeftUpperArm, Role::RightUpperArm)]

@@ -191,14 +191,27 @@ fn unknown_names_are_located_with_suggestions() {
 }
 
 #[test]
-fn positions_are_in_metres_not_nan() {
-    // Guard: a config with a NaN-free but absurd scale still solves without NaN.
+fn root_position_is_in_metres_and_far_targets_stay_finite() {
     let model = g1();
     let body = model.body_id("pelvis").unwrap();
-    let target = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(1e3, -1e3, 1e3) };
     let tasks = vec![TaskSpec { body, target: 0, pos_weight: 1.0, rot_weight: 1.0 }];
+    // A pelvis target 0.5 m forward and 0.3 m right of its home pose: after a second of
+    // frames the free root (`qpos[0..3]`, metres) stands there, not 100× or 1/100 of it.
+    let home = Vector3::new(model.qpos0[0], model.qpos0[1], model.qpos0[2]);
+    let goal = home + Vector3::new(0.5, -0.3, 0.0);
+    let target = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: goal };
+    let mut solver =
+        Solver::new(&model, std::slice::from_ref(&tasks), SolverOptions::default()).unwrap();
+    for _ in 0..30 {
+        solver.solve_frame(&[target], 1.0 / 30.0);
+    }
+    let q = solver.qpos();
+    let root = Vector3::new(q[0], q[1], q[2]);
+    assert!((root - goal).norm() < 1e-3, "root at {root:?}, target {goal:?} (metres)");
+    // A target a kilometre away: one damped step, finite, no QP failure.
+    let far = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(1e3, -1e3, 1e3) };
     let mut solver = Solver::new(&model, &[tasks], SolverOptions::default()).unwrap();
-    let d = solver.solve_frame(&[target], 1.0 / 30.0);
+    let d = solver.solve_frame(&[far], 1.0 / 30.0);
     assert!(solver.qpos().iter().all(|v| v.is_finite()));
     assert_eq!(d.qp_failures, 0);
 }

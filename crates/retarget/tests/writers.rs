@@ -114,6 +114,47 @@ fn bad_motions_are_typed_errors_and_write_nothing() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
 }
 
+/// An `.npz` holding one stored member `key.npy` with these bytes.
+fn npz_with(path: &Path, key: &str, npy: &[u8]) {
+    use std::io::Write;
+    let mut zip = zip::ZipWriter::new(std::fs::File::create(path).unwrap());
+    let options =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    zip.start_file(format!("{key}.npy"), options).unwrap();
+    zip.write_all(npy).unwrap();
+    zip.finish().unwrap();
+}
+
+/// Issue 15: a 256-byte `.npz` whose member claims 1e14 `<U0` strings made the reader
+/// allocate 2.4 PB and abort. Every count read from a file is now checked against the bytes
+/// that hold it: crafted headers are errors naming the member.
+#[test]
+fn crafted_npz_headers_are_errors_not_allocations() {
+    let dir = scratch_dir("crafted");
+    let npy = |descr: &str, shape: &str| {
+        let header =
+            format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}\n");
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        bytes.extend_from_slice(&u16::try_from(header.len()).unwrap().to_le_bytes());
+        bytes.extend_from_slice(header.as_bytes());
+        bytes
+    };
+    let cases = [
+        ("<U0", "(100000000000000,)", "dtype <U0 with 100000000000000 elements in 0 bytes"),
+        ("<U4", "(100000000000000,)", "array data truncated (<U4, 100000000000000 elements)"),
+        ("<f8", "(4294967296, 65536)", "array data truncated"),
+        ("<f8", "(4294967296, 4294967296, 4294967296)", "shape overflows"),
+        ("<U99999999999999999999", "(1,)", "bad dtype"),
+    ];
+    for (descr, shape, expected) in cases {
+        let path = dir.join("crafted.npz");
+        npz_with(&path, "joint_names", &npy(descr, shape));
+        let err = read_motion_npz(&path).unwrap_err().to_string();
+        assert!(err.contains("crafted.npz") && err.contains("joint_names"), "{err}");
+        assert!(err.contains(expected), "{descr} {shape}: {err}");
+    }
+}
+
 #[test]
 fn csv_is_unitree_layout_and_round_trips_in_rust() {
     let Some(model) = g1() else { return };

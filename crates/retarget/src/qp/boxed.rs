@@ -51,6 +51,9 @@ pub struct BoxQp {
     /// Kinematic-tree sparsity of `h` (see [`BoxQp::set_tree`]) and its restriction to the
     /// free variables.
     parent: Option<Vec<Option<usize>>>,
+    /// Per variable, its ancestors nearest first (the chains of `parent`), for the all-free
+    /// factorisation.
+    chains: Vec<Vec<usize>>,
     free_parent: Vec<Option<usize>>,
     /// Number of active-set iterations of the last solve.
     pub iterations: usize,
@@ -72,6 +75,7 @@ impl BoxQp {
             rhs: vec![0.0; n],
             y: vec![0.0; n],
             parent: None,
+            chains: Vec::new(),
             free_parent: vec![None; n],
             iterations: 0,
         }
@@ -90,6 +94,13 @@ impl BoxQp {
     pub fn set_tree(&mut self, parent: Vec<Option<usize>>) {
         let ok = parent.len() == self.n
             && parent.iter().enumerate().all(|(i, p)| p.is_none_or(|p| p < i));
+        self.chains = if ok {
+            (0..self.n)
+                .map(|i| std::iter::successors(parent[i], |&p| parent[p]).collect())
+                .collect()
+        } else {
+            Vec::new()
+        };
         self.parent = ok.then_some(parent);
     }
 
@@ -223,9 +234,62 @@ impl BoxQp {
         r
     }
 
+    /// [`BoxQp::solve_face_tree`] with every variable free (the common case): the same
+    /// operations in the same order, over precomputed ancestor chains.
+    fn solve_all_free_tree(&mut self) -> bool {
+        let n = self.n;
+        self.free.clear();
+        self.free.extend(0..n);
+        self.chol.copy_from_slice(&self.h);
+        for (y, c) in self.y.iter_mut().zip(&self.c) {
+            *y = -c;
+        }
+        let l = &mut self.chol;
+        for k in (0..n).rev() {
+            let (above, rest) = l.split_at_mut(k * n);
+            let row_k = &mut rest[..n];
+            let dk = row_k[k];
+            if dk.is_nan() || dk <= 0.0 || !dk.is_finite() {
+                return false;
+            }
+            let chain = &self.chains[k];
+            for (a, &ii) in chain.iter().enumerate() {
+                let tmp = row_k[ii] / dk;
+                let row_ii = &mut above[ii * n..(ii + 1) * n];
+                for &jj in &chain[a..] {
+                    row_ii[jj] -= tmp * row_k[jj];
+                }
+                row_k[ii] = tmp;
+            }
+        }
+        let y = &mut self.y;
+        for k in (0..n).rev() {
+            let yk = y[k];
+            for &ii in &self.chains[k] {
+                y[ii] -= l[k * n + ii] * yk;
+            }
+        }
+        for k in 0..n {
+            y[k] /= l[k * n + k];
+        }
+        for k in 0..n {
+            let row_k = &l[k * n..(k + 1) * n];
+            let mut yk = y[k];
+            for &ii in &self.chains[k] {
+                yk -= row_k[ii] * y[ii];
+            }
+            y[k] = yk;
+            self.rhs[k] = yk;
+        }
+        true
+    }
+
     /// `mj_factorI` / `mj_solveM` on the free variables, fixed ones cut out of the tree.
     fn solve_face_tree(&mut self) -> bool {
         let n = self.n;
+        if self.state.iter().all(|s| *s == State::Free) && self.chains.len() == n {
+            return self.solve_all_free_tree();
+        }
         let Some(parent) = self.parent.as_ref() else { return false };
         self.free.clear();
         self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));

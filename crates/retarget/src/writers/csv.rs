@@ -3,6 +3,9 @@
 //! `qx, qy, qz, qw`, then every other `qpos` entry in MJCF order. Numbers are the shortest
 //! strings that parse back to the same `f64` (ryu).
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::io::Write;
 
 use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, BodyPoses};
@@ -26,7 +29,7 @@ pub(crate) fn write_csv<W: Write>(
         line.clear();
         let (pos, wxyz) = root_pose(motion, model, &poses, t);
         let xyzw = xyzw_from_wxyz(wxyz);
-        let values = pos.iter().chain(&xyzw).chain(&motion.frame(t)[skip..]);
+        let values = pos.iter().chain(&xyzw).chain(motion.frame(t).get(skip..).unwrap_or_default());
         for (i, v) in values.enumerate() {
             if i > 0 {
                 line.push(',');

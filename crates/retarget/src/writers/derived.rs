@@ -1,6 +1,9 @@
 //! Quantities derived from `qpos`: world body poses (forward kinematics) and finite-difference
 //! velocities, shared by the writers and the quality report.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::motion::RobotMotion;
@@ -14,6 +17,9 @@ pub(crate) struct BodyPoses {
     pub quat: Vec<UnitQuaternion<f64>>,
 }
 
+// `frame × bodies` arrays filled by `body_poses`; callers index frames and bodies of the
+// same motion and model, so an out-of-range index is a bug, not input.
+#[allow(clippy::indexing_slicing)]
 impl BodyPoses {
     pub fn pos(&self, frame: usize, body: usize) -> Vector3<f64> {
         self.pos[frame * self.bodies + body]
@@ -33,8 +39,8 @@ pub(crate) fn body_poses(motion: &RobotMotion, model: &mjcf::Model) -> BodyPoses
     let mut quat = Vec::with_capacity(frames * bodies);
     for t in 0..frames {
         model.kinematics(motion.frame(t), &mut data);
-        pos.extend_from_slice(&data.xpos[1..]);
-        quat.extend_from_slice(&data.xquat[1..]);
+        pos.extend_from_slice(data.xpos.get(1..).unwrap_or_default());
+        quat.extend_from_slice(data.xquat.get(1..).unwrap_or_default());
     }
     BodyPoses { bodies, pos, quat }
 }
@@ -61,8 +67,14 @@ pub(crate) fn gradient_rows(values: &[f64], cols: usize, dt: f64) -> Vec<f64> {
     for t in 0..frames {
         let Some((a, b)) = gradient_pair(t, frames) else { continue };
         let h = (b - a) as f64 * dt;
-        for c in 0..cols {
-            out[t * cols + c] = (values[b * cols + c] - values[a * cols + c]) / h;
+        let (Some(after), Some(before)) =
+            (values.get(b * cols..(b + 1) * cols), values.get(a * cols..(a + 1) * cols))
+        else {
+            continue;
+        };
+        let row = out.iter_mut().skip(t * cols).take(cols);
+        for ((o, x1), x0) in row.zip(after).zip(before) {
+            *o = (x1 - x0) / h;
         }
     }
     out
@@ -81,9 +93,15 @@ pub(crate) fn angular_velocity(
     for t in 0..frames {
         let Some((a, b)) = gradient_pair(t, frames) else { continue };
         let h = (b - a) as f64 * dt;
-        for k in 0..per_frame {
-            let delta = quats[b * per_frame + k] * quats[a * per_frame + k].inverse();
-            out[t * per_frame + k] = delta.scaled_axis() / h;
+        let (Some(after), Some(before)) = (
+            quats.get(b * per_frame..(b + 1) * per_frame),
+            quats.get(a * per_frame..(a + 1) * per_frame),
+        ) else {
+            continue;
+        };
+        let row = out.iter_mut().skip(t * per_frame).take(per_frame);
+        for ((o, q1), q0) in row.zip(after).zip(before) {
+            *o = (q1 * q0.inverse()).scaled_axis() / h;
         }
     }
     out

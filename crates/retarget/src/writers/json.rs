@@ -13,6 +13,9 @@
 //! }
 //! ```
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::io::Write;
 
 use serde_json::json;
@@ -55,13 +58,13 @@ pub(crate) fn write_json<W: Write>(
             writeln!(out, ",\n  \"targets\": {{")?;
             writeln!(out, "    \"body_names\": {},", serde_json::to_string(&targets.body_names)?)?;
             let pos_rows = (0..frames).map(|t| {
-                let row = &targets.pos[t * k..(t + 1) * k];
+                let row = targets.pos.get(t * k..(t + 1) * k).unwrap_or_default();
                 serde_json::to_string(&row.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>())
             });
             write_rows(out, "    ", "pos", pos_rows)?;
             writeln!(out, ",")?;
             let quat_rows = (0..frames).map(|t| {
-                let row = &targets.quat[t * k..(t + 1) * k];
+                let row = targets.quat.get(t * k..(t + 1) * k).unwrap_or_default();
                 serde_json::to_string(&row.iter().map(|q| [q.w, q.i, q.j, q.k]).collect::<Vec<_>>())
             });
             write_rows(out, "    ", "quat", quat_rows)?;

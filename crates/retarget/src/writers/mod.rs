@@ -9,6 +9,9 @@
 //! then renamed over it. On error the temporary file is removed, so an interrupted or failed
 //! run never leaves a half-written file under the final name.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 mod csv;
 mod derived;
 mod json;
@@ -24,7 +27,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use crate::motion::RobotMotion;
 
 pub(crate) use derived::{angular_velocity, body_poses, gradient_rows, BodyPoses};
-pub use npz::{read_motion_npz, read_npz_robot};
+pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
 
 /// Output formats, chosen by file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -154,7 +157,8 @@ pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<
     }
     if let Some(i) = motion.qpos.iter().position(|v| !v.is_finite()) {
         let (frame, index) = (i / motion.nq, i % motion.nq);
-        return Err(Error::NonFiniteQpos { frame, index, value: motion.qpos[i] });
+        let value = motion.qpos.get(i).copied().unwrap_or(f64::NAN);
+        return Err(Error::NonFiniteQpos { frame, index, value });
     }
     if let Some(t) = &motion.targets {
         let expected = motion.num_frames() * t.body_names.len();
@@ -187,8 +191,10 @@ pub(crate) fn root_pose(
     frame: usize,
 ) -> ([f64; 3], [f64; 4]) {
     if root_nq(model) == 7 {
-        let q = motion.frame(frame);
-        ([q[0], q[1], q[2]], [q[3], q[4], q[5], q[6]])
+        match motion.frame(frame) {
+            &[x, y, z, w, i, j, k, ..] => ([x, y, z], [w, i, j, k]),
+            _ => ([0.0; 3], [1.0, 0.0, 0.0, 0.0]),
+        }
     } else {
         let p = poses.pos(frame, 0);
         let q = poses.quat(frame, 0);

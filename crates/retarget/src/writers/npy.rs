@@ -4,6 +4,9 @@
 //! (`<U`n: n UTF-32LE code units per element, NUL-padded) arrays, as `numpy.save` does, and
 //! read those plus `<f4`, `<i4`, `<i8` (converted to `f64`).
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 const MAGIC: &[u8] = b"\x93NUMPY";
 
 /// Array contents.
@@ -106,29 +109,36 @@ fn data_len(data: &ArrayData, width: usize) -> usize {
     }
 }
 
-/// Parses `.npy` bytes. Errors are messages for the caller to put a file name on.
+/// Parses `.npy` bytes. Errors are messages for the caller to put a file name on. Every
+/// allocation is bounded by `bytes.len()`: element counts read from the header are checked
+/// against the data present before anything is allocated.
 pub fn decode(bytes: &[u8]) -> Result<Array, String> {
-    if bytes.len() < 10 || &bytes[..6] != MAGIC {
+    let (Some(magic), Some(&version)) = (bytes.get(..6), bytes.get(6)) else {
+        return Err("not a .npy array (bad magic)".to_owned());
+    };
+    if magic != MAGIC {
         return Err("not a .npy array (bad magic)".to_owned());
     }
-    let (header_len, start) = match bytes[6] {
-        1 => (usize::from(u16::from_le_bytes([bytes[8], bytes[9]])), 10),
-        2 | 3 if bytes.len() >= 12 => {
-            (u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize, 12)
-        }
+    let le = |range: std::ops::Range<usize>| -> Option<usize> {
+        let raw = bytes.get(range)?;
+        Some(raw.iter().rev().fold(0usize, |a, &b| (a << 8) | usize::from(b)))
+    };
+    let (header_len, start) = match version {
+        1 => (le(8..10), 10),
+        2 | 3 => (le(8..12), 12),
         v => return Err(format!("unsupported .npy format version {v}")),
     };
-    let header = bytes
-        .get(start..start + header_len)
-        .and_then(|h| std::str::from_utf8(h).ok())
-        .ok_or("truncated or non-text .npy header")?;
+    let header_end = header_len.and_then(|n| n.checked_add(start));
+    let (header, body) = header_end
+        .and_then(|end| Some((bytes.get(start..end)?, bytes.get(end..)?)))
+        .ok_or("truncated .npy header")?;
+    let header = std::str::from_utf8(header).map_err(|_| "non-text .npy header")?;
     let descr = quoted_value(header, "descr").ok_or("no 'descr' in the .npy header")?;
     if header_value(header, "fortran_order").is_some_and(|v| v.starts_with("True")) {
         return Err("Fortran-order arrays are not supported".to_owned());
     }
     let shape = parse_shape(header).ok_or("no valid 'shape' in the .npy header")?;
     let count = shape.iter().try_fold(1usize, |a, &d| a.checked_mul(d)).ok_or("shape overflows")?;
-    let body = &bytes[start + header_len..];
     let data = decode_data(descr, body, count)?;
     Ok(Array { shape, data })
 }
@@ -150,8 +160,18 @@ fn decode_data(descr: &str, body: &[u8], count: usize) -> Result<ArrayData, Stri
         "<i4" => floats(4, &|c| f64::from(i32::from_le_bytes(c.try_into().unwrap_or([0; 4])))),
         "|b1" => Ok(ArrayData::Bool(need(1)?.iter().map(|&b| b != 0).collect())),
         d if d.starts_with("<U") => {
-            let width: usize = d[2..].parse().map_err(|_| format!("bad dtype {d}"))?;
+            let width: usize =
+                d.get(2..).and_then(|w| w.parse().ok()).ok_or_else(|| format!("bad dtype {d}"))?;
             if width == 0 {
+                // Zero-width elements take no bytes, so the data cannot bound their count:
+                // numpy never writes `<U0` with elements (it widens to `<U1`), and a count
+                // larger than the member is a crafted file, not an array.
+                if count > body.len() {
+                    return Err(format!(
+                        "dtype <U0 with {count} elements in {} bytes of data",
+                        body.len()
+                    ));
+                }
                 return Ok(ArrayData::Str(vec![String::new(); count]));
             }
             let raw = need(width.checked_mul(4).ok_or("bad unicode width")?)?;
@@ -159,7 +179,7 @@ fn decode_data(descr: &str, body: &[u8], count: usize) -> Result<ArrayData, Stri
             for element in raw.chunks_exact(width * 4) {
                 let mut s = String::new();
                 for unit in element.chunks_exact(4) {
-                    let code = u32::from_le_bytes([unit[0], unit[1], unit[2], unit[3]]);
+                    let code = unit.iter().rev().fold(0u32, |a, &b| (a << 8) | u32::from(b));
                     if code == 0 {
                         break;
                     }
@@ -169,27 +189,27 @@ fn decode_data(descr: &str, body: &[u8], count: usize) -> Result<ArrayData, Stri
             }
             Ok(ArrayData::Str(items))
         }
-        d => Err(format!("unsupported dtype {d} (expected <f8, <f4, <i8, <i4 or <U)")),
+        d => Err(format!("unsupported dtype {d} (expected <f8, <f4, <i8, <i4, |b1 or <U)")),
     }
 }
 
 /// The text after `'key':` in a header dict.
 fn header_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
     let at = header.find(&format!("'{key}'"))?;
-    let rest = &header[at + key.len() + 2..];
+    let rest = header.get(at + key.len() + 2..)?;
     Some(rest.trim_start().strip_prefix(':')?.trim_start())
 }
 
 fn quoted_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {
     let v = header_value(header, key)?;
     let quote = v.chars().next().filter(|c| *c == '\'' || *c == '"')?;
-    let v = &v[1..];
-    Some(&v[..v.find(quote)?])
+    let v = v.get(1..)?;
+    v.get(..v.find(quote)?)
 }
 
 fn parse_shape(header: &str) -> Option<Vec<usize>> {
     let v = header_value(header, "shape")?.strip_prefix('(')?;
-    let inner = &v[..v.find(')')?];
+    let inner = v.get(..v.find(')')?)?;
     inner
         .split(',')
         .map(str::trim)
@@ -244,5 +264,27 @@ mod tests {
         let mut bytes = encode(&Array::f64(vec![4], vec![1.0; 4]));
         bytes.truncate(bytes.len() - 1);
         assert!(decode(&bytes).unwrap_err().contains("truncated"));
+        for cut in 0..bytes.len() {
+            assert!(decode(&bytes[..cut]).is_err(), "{cut}");
+        }
+    }
+
+    /// A 128-byte member claiming 1e14 zero-width strings (24 bytes each in memory) used to
+    /// abort the process on the allocation; now the count is checked against the data.
+    #[test]
+    fn zero_width_strings_cannot_claim_more_elements_than_bytes() {
+        let header = "{'descr': '<U0', 'fortran_order': False, 'shape': (100000000000000,), }";
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+        bytes.extend_from_slice(header.as_bytes());
+        let err = decode(&bytes).unwrap_err();
+        assert_eq!(err, "dtype <U0 with 100000000000000 elements in 0 bytes of data");
+        // A header length past the end, and a version-2 length of 4 GiB: errors, no panic.
+        let mut long = bytes.clone();
+        long.splice(8..10, [0xff, 0xff]);
+        assert_eq!(decode(&long).unwrap_err(), "truncated .npy header");
+        let mut v2 = b"\x93NUMPY\x02\x00\xff\xff\xff\xff".to_vec();
+        v2.extend_from_slice(header.as_bytes());
+        assert_eq!(decode(&v2).unwrap_err(), "truncated .npy header");
     }
 }

@@ -1,6 +1,9 @@
 //! `.npz`: numpy's zip archive of `<key>.npy` members (as `numpy.savez_compressed` writes it:
 //! deflate), and the reader for our own files.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{Read, Seek, Write};
@@ -30,7 +33,9 @@ pub(crate) fn motion_arrays(
     }
     let skip = root_nq(model);
     let cols = motion.nq - skip;
-    let joint_pos: Vec<f64> = (0..frames).flat_map(|t| motion.frame(t)[skip..].to_vec()).collect();
+    let joint_pos: Vec<f64> = (0..frames)
+        .flat_map(|t| motion.frame(t).get(skip..).unwrap_or_default().to_vec())
+        .collect();
     let joint_vel = gradient_rows(&joint_pos, cols, dt);
     arrays.push(("joint_pos", Array::f64(vec![frames, cols], joint_pos)));
     arrays.push(("joint_vel", Array::f64(vec![frames, cols], joint_vel)));
@@ -81,19 +86,53 @@ pub(crate) fn write_npz<W: Write + Seek>(out: W, arrays: &[(&str, Array)]) -> st
     Ok(())
 }
 
-/// Every `<key>.npy` of an `.npz`, by key.
+/// Deflate's largest expansion: 258 bytes from a 2-bit code, i.e. about 1032 to 1 (zlib's
+/// technical details, "Maximum compression factor").
+const MAX_DEFLATE_RATIO: u64 = 1032;
+
+/// Every `<key>.npy` of an `.npz`, by key. Allocations are bounded by the file's size.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
-    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
     let file =
         File::open(path).map_err(|source| Error::File { path: path.to_path_buf(), source })?;
+    read_npz_from(file, path)
+}
+
+/// [`read_npz`] on any reader; `path` names it in errors.
+fn read_npz_from<R: Read + Seek>(
+    mut reader: R,
+    path: &Path,
+) -> Result<BTreeMap<String, Array>, Error> {
+    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
+    let io_error = |source| Error::File { path: path.to_path_buf(), source };
+    // The archive's real length: the only size in it that the file cannot lie about.
+    let file_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io_error)?;
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(io_error)?;
     let mut zip =
-        zip::ZipArchive::new(file).map_err(|e| read_error(format!("not an .npz: {e}")))?;
+        zip::ZipArchive::new(reader).map_err(|e| read_error(format!("not an .npz: {e}")))?;
     let mut arrays = BTreeMap::new();
     for i in 0..zip.len() {
         let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
         let Some(key) = member.name().strip_suffix(".npy").map(str::to_owned) else { continue };
-        let mut bytes = Vec::with_capacity(usize::try_from(member.size()).unwrap_or(0));
-        member.read_to_end(&mut bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
+        // Sizes in the headers are the file's word: the compressed size cannot exceed the
+        // archive, the declared size cannot exceed what those bytes inflate to (deflate
+        // expands at most 1032:1), reading stops at the declared size, and the buffer starts
+        // no larger than the archive (it grows only with bytes really inflated).
+        let (size, packed) = (member.size(), member.compressed_size().min(file_len));
+        let bound = match member.compression() {
+            zip::CompressionMethod::Stored => packed,
+            _ => packed.saturating_mul(MAX_DEFLATE_RATIO).saturating_add(1024),
+        };
+        if size > bound {
+            return Err(read_error(format!(
+                "{key}: member claims {size} bytes from {packed} stored bytes"
+            )));
+        }
+        let mut bytes = Vec::with_capacity(usize::try_from(size.min(file_len)).unwrap_or(0));
+        member
+            .by_ref()
+            .take(size)
+            .read_to_end(&mut bytes)
+            .map_err(|e| read_error(format!("{key}: {e}")))?;
         let array = npy::decode(&bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
         arrays.insert(key, array);
     }
@@ -105,7 +144,15 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
 /// `target_body_names`, `target_pos` (T×K×3), `target_quat` (T×K×4, w first), and
 /// `contact_left`, `contact_right` (T bools)).
 pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
-    let arrays = read_npz(path)?;
+    motion_from_arrays(&read_npz(path)?, path)
+}
+
+/// [`read_motion_npz`] on the bytes of an `.npz` (`name` is used in errors).
+pub fn read_motion_npz_bytes(bytes: &[u8], name: &Path) -> Result<RobotMotion, Error> {
+    motion_from_arrays(&read_npz_from(std::io::Cursor::new(bytes), name)?, name)
+}
+
+fn motion_from_arrays(arrays: &BTreeMap<String, Array>, path: &Path) -> Result<RobotMotion, Error> {
     let err = |message: String| Error::Read { path: path.to_path_buf(), message };
     let get = |key: &str| arrays.get(key).ok_or_else(|| err(format!("no `{key}` array")));
     let fps = match floats(get("fps")?) {
@@ -164,11 +211,14 @@ fn read_targets(
             pos.shape, quat.shape
         ));
     }
-    let pos = p.chunks_exact(3).map(|c| Vector3::new(c[0], c[1], c[2])).collect();
+    let pos = p.chunks_exact(3).map(Vector3::from_column_slice).collect();
     let quat = q
         .chunks_exact(4)
         .map(|c| {
-            let q = Quaternion::new(c[0], c[1], c[2], c[3]);
+            let &[w, x, y, z] = c else {
+                return Err("a target quaternion has not 4 numbers".to_owned());
+            };
+            let q = Quaternion::new(w, x, y, z);
             match q.norm() {
                 n if (n - 1.0).abs() < 1e-9 => Ok(UnitQuaternion::new_unchecked(q)),
                 n if n > 1e-9 && n.is_finite() => Ok(UnitQuaternion::new_normalize(q)),

@@ -12,6 +12,9 @@
 //! `ndarray.__setstate__`. `numpy.ndarray` and `numpy.dtype` resolve the same on numpy 1.x
 //! and 2.x (unlike `numpy.core.multiarray._reconstruct`, which numpy 2 moved to `numpy._core`).
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, Error};
 use crate::motion::RobotMotion;
 
@@ -52,7 +55,9 @@ pub(crate) fn motion_pickle(motion: &RobotMotion, model: &mjcf::Model) -> Result
             local.extend_from_slice(&[v.x, v.y, v.z]);
         }
     }
-    let dof_pos: Vec<f64> = (0..frames).flat_map(|t| motion.frame(t)[skip..].to_vec()).collect();
+    let dof_pos: Vec<f64> = (0..frames)
+        .flat_map(|t| motion.frame(t).get(skip..).unwrap_or_default().to_vec())
+        .collect();
 
     let mut p = Pickler::default();
     p.out.extend_from_slice(&[PROTO, 3, EMPTY_DICT, MARK]);
