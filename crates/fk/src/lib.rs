@@ -153,6 +153,15 @@ fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
     roles::Samples { rest: rest_pose(plan, &file), frames }
 }
 
+/// The body names [`human_motion`] gives `bvh` with `options` (joints, End Sites, derived
+/// bodies), without running the forward kinematics.
+pub fn body_names(bvh: &Bvh, options: &FkOptions) -> Result<Vec<String>, Error> {
+    let mut names: Vec<String> = bvh.skeleton.joints.iter().map(|j| j.name.clone()).collect();
+    let derived = resolve_derived(&names, &options.derived)?;
+    names.extend(derived.into_iter().map(|d| d.name));
+    Ok(names)
+}
+
 /// Forward kinematics of every frame of `bvh`, converted to our world (see [`FkOptions`]).
 /// A clip without frames, or whose poses are absurd ([`HumanMotion::validate`]), is an error.
 pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkReport), Error> {

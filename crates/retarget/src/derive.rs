@@ -687,8 +687,8 @@ pub fn choose(
     let source = format!("<derived for {robot}>");
     let derived = derive(model, &roles, &human, &source)?;
     if let Some(tuned) = tuned {
-        let (motion, _) = fk::human_motion(bvh, fk_options)?;
-        let names_fit = tuned.validate(model, &motion.body_names).is_ok();
+        let names = fk::body_names(bvh, fk_options)?;
+        let names_fit = tuned.validate(model, &names).is_ok();
         let angle = largest_offset_difference(tuned, &bind_names(&derived, tuned, &human));
         if names_fit && angle.is_some_and(|a| a <= TUNED_AGREES) {
             let summary = format!(

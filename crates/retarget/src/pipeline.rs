@@ -303,32 +303,37 @@ impl<'a> Prepared<'a> {
             fps: human.fps,
             height,
         };
+        // The source's contact phases are written in both modes (GMR's solve ignores them);
+        // the default mode plants the feet on them.
+        let contact = match &options.mode {
+            SolveMode::Plausible(p) => p.contact.clone(),
+            SolveMode::Gmr => crate::contact::ContactOptions::default(),
+        };
+        if let Some(points) = crate::contact::human_foot_points(&human.body_names) {
+            prepared.contacts = Some(crate::contact::detect(human, points, &contact));
+        }
         if let SolveMode::Plausible(plausible) = &options.mode {
             if plausible.planting == Planting::On {
-                prepared.plan_feet(human, plausible);
+                prepared.plan_feet(plausible);
             }
         }
         Ok(prepared)
     }
 
-    /// Source contacts, then planted foot targets (when both the human's and the robot's
+    /// Planted foot targets from the source contacts (when both the human's and the robot's
     /// feet are found; otherwise the targets stay GMR's and only the constraints apply).
-    fn plan_feet(&mut self, human: &HumanMotion, options: &PlausibleOptions) {
-        let Some(points) = crate::contact::human_foot_points(&human.body_names) else {
-            return;
-        };
-        let contacts = crate::contact::detect(human, points, &options.contact);
+    fn plan_feet(&mut self, options: &PlausibleOptions) {
+        let Some(contacts) = &self.contacts else { return };
         let feet = robot_feet(self.model, &self.stages);
         let plan = crate::feet::plan(
             &feet,
-            &contacts,
+            contacts,
             &mut self.targets,
             self.slots,
             self.fps,
             &options.feet,
         );
         self.plan = Some((feet.map(|f| f.map(|f| f.body)), plan));
-        self.contacts = Some(contacts);
     }
 
     fn contact_weight(&self) -> f64 {
@@ -388,8 +393,7 @@ impl<'a> Prepared<'a> {
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
-                    let targets = self.frame_targets(f);
-                    solver.repair_frame(reference, targets, p.repair_weight, p.repair_steps, dt)?;
+                    solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
                     let (pos_error, rot_error) = solver.errors(self.frame_targets(f));
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);

@@ -581,13 +581,11 @@ impl<'m> Solver<'m> {
 
     /// Moves the solution of the frame just solved to `reference` (same frame; e.g. the
     /// trajectory smoothed in time), then corrects it for the constraints and this frame's
-    /// point tasks with `steps` steps of the last stage's tasks (`targets`) plus a pull to
-    /// `reference` (weight `weight` per dof). The next frame's speed limits count from the
-    /// result.
+    /// point tasks with `steps` steps that otherwise stay close to `reference` (weight
+    /// `weight` per dof). The next frame's speed limits count from the result.
     pub fn repair_frame(
         &mut self,
         reference: &[f64],
-        targets: &[Pose],
         weight: f64,
         steps: usize,
         dt: f64,
@@ -604,17 +602,11 @@ impl<'m> Solver<'m> {
         for _ in 0..steps {
             self.qp.h.fill(0.0);
             self.qp.c.fill(0.0);
-            let mut mu_total = 0.0;
-            if let Some(s) = self.stages.len().checked_sub(1) {
-                self.stage_error(s, targets);
-                for k in 0..self.stages[s].len() {
-                    mu_total += self.task_objective(s, k, targets);
-                }
-            }
+
             self.add_posture(reference, weight);
             self.add_point_tasks();
             for d in 0..nv {
-                self.qp.h[d * nv + d] += self.options.damping + mu_total;
+                self.qp.h[d * nv + d] += self.options.damping;
                 for e in 0..d {
                     self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
                 }

@@ -356,7 +356,9 @@ impl DenseQp {
             // linearly on the active normals).
             let zn: f64 = self.d[q..].iter().map(|v| v * v).sum();
             let nn = dot(&self.normal, &self.normal);
-            let t2 = if zn > 1e-22 * nn { -slack / zn } else { f64::INFINITY };
+            // A normal (nearly) in the span of the active ones has a tiny z: treat it as
+            // dependent (a dual step), as a full step along it would be huge and wrong.
+            let t2 = if zn > 1e-12 * nn { -slack / zn } else { f64::INFINITY };
             let t = t1.min(t2);
             if t == f64::INFINITY {
                 return Err(QpStatus::Infeasible);
