@@ -3,6 +3,9 @@
 //! algorithms live in the library crates (the Python package adds `retarget.gmr`, a thin
 //! layer of GMR's names over these functions).
 
+// No panics on input: a panic would reach Python as `PanicException`, not a `RetargetError`.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
@@ -279,11 +282,16 @@ fn human_motion(frames: &Bound<'_, PyAny>, fps: f64) -> PyResult<fk::HumanMotion
             human.body_names.clone_from(&frame.body_names);
         }
         for name in &human.body_names {
-            let i = frame.body_names.iter().position(|n| n == name).ok_or_else(|| {
+            let found = frame
+                .body_names
+                .iter()
+                .position(|n| n == name)
+                .and_then(|i| Some((frame.positions.get(i)?, frame.orientations.get(i)?)));
+            let (position, orientation) = found.ok_or_else(|| {
                 PyValueError::new_err(format!("frame {}: no body {name:?}", human.num_frames))
             })?;
-            human.positions.push(frame.positions[i]);
-            human.orientations.push(frame.orientations[i]);
+            human.positions.push(*position);
+            human.orientations.push(*orientation);
         }
         human.num_frames += 1;
     }
@@ -536,12 +544,12 @@ fn load_bvh_gmr<'py>(
         })
         .map_err(|e: retarget::Error| to_py(e))?;
     let frames = PyList::empty(py);
-    let nb = human.num_bodies();
-    for f in 0..human.num_frames {
+    // Frame by frame (`max(1)`: a motion without bodies has no rows to split).
+    let nb = human.num_bodies().max(1);
+    let rows = human.positions.chunks_exact(nb).zip(human.orientations.chunks_exact(nb));
+    for (positions, orientations) in rows {
         let frame = PyDict::new(py);
-        for (b, name) in human.body_names.iter().enumerate() {
-            let p = human.positions[f * nb + b];
-            let q = human.orientations[f * nb + b];
+        for ((name, p), q) in human.body_names.iter().zip(positions).zip(orientations) {
             let pos = PyArray1::from_slice(py, &[p.x, p.y, p.z]);
             let quat = PyArray1::from_slice(py, &[q.w, q.i, q.j, q.k]);
             frame.set_item(name, PyList::new(py, [pos.into_any(), quat.into_any()])?)?;

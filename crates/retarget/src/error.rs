@@ -1,6 +1,9 @@
 //! The one error type of the crate: configs, robots, solving, writing and reading motions.
 //! The errors of the crates below (`bvh`, `c3d`, `fk`, `mjcf`) convert into it with `?`.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::path::PathBuf;
 
 /// Everything that can go wrong in the retargeting crate.

@@ -3,6 +3,9 @@
 //! `LeftFootMod` and `RightFootMod` (foot position, toe orientation), in metres from
 //! centimetres, Y up turned to Z up as GMR turns it, and GMR's constant subject height.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use bvh::Bvh;
 use fk::{AxisConvention, DerivedBody, FkOptions, HumanMotion, UnitChoice};
 
@@ -61,18 +64,18 @@ pub fn load_bvh(bvh: &Bvh, format: BvhFormat) -> Result<HumanMotion, Error> {
     let keep: Vec<usize> = (0..motion.num_bodies())
         .filter(|&b| bvh.skeleton.joints.get(b).is_none_or(|j| j.kind != bvh::JointKind::End))
         .collect();
-    let nb = motion.num_bodies();
+    // Frame by frame (`max(1)`: a motion without bodies has no rows to split).
+    let nb = motion.num_bodies().max(1);
+    let rows = motion.positions.chunks_exact(nb).zip(motion.orientations.chunks_exact(nb));
     let mut positions = Vec::with_capacity(motion.num_frames * keep.len());
     let mut orientations = Vec::with_capacity(motion.num_frames * keep.len());
-    for f in 0..motion.num_frames {
-        for &b in &keep {
-            positions.push(motion.positions[f * nb + b]);
-            orientations.push(motion.orientations[f * nb + b]);
-        }
+    for (pos, rot) in rows {
+        positions.extend(keep.iter().filter_map(|&b| pos.get(b)));
+        orientations.extend(keep.iter().filter_map(|&b| rot.get(b)));
     }
     Ok(HumanMotion {
         fps: motion.fps,
-        body_names: keep.iter().map(|&b| motion.body_names[b].clone()).collect(),
+        body_names: keep.iter().filter_map(|&b| motion.body_names.get(b).cloned()).collect(),
         num_frames: motion.num_frames,
         positions,
         orientations,

@@ -6,6 +6,9 @@
 //! The C3D bytes are parsed by the `c3d` crate; the virtual bodies are built by `fk`.
 //! Example: `configs/c3d_plugingait_to_unitree_g1.json`.
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::path::Path;
 
 use fk::markers::MarkerBody;

@@ -18,6 +18,9 @@
 //!
 //! [`Planting::Off`]: crate::pipeline::Planting::Off
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
@@ -577,8 +580,8 @@ impl Stream {
         };
         self.map.compute(positions, orientations, &mut self.targets);
         if let Some(bad) = self.targets.iter().position(|p| !finite_pose(p)) {
-            let message =
-                format!("target of human body `{}` is not finite", self.map.bodies[bad].name);
+            let name = self.map.bodies.get(bad).map_or("?", |b| b.name.as_str());
+            let message = format!("target of human body `{name}` is not finite");
             return Err(Error::NonFinite { frame: self.frames, message });
         }
         let first = self.frames == 0;
@@ -609,14 +612,19 @@ impl Stream {
         self.positions.clear();
         self.orientations.clear();
         for name in &self.names {
-            let Some(i) = frame.body_names.iter().position(|n| n == name) else {
+            let found = frame
+                .body_names
+                .iter()
+                .position(|n| n == name)
+                .and_then(|i| Some((frame.positions.get(i)?, frame.orientations.get(i)?)));
+            let Some((position, orientation)) = found else {
                 return Err(Error::InvalidOption(format!(
                     "frame {}: body `{name}` of the first frame is missing",
                     self.frames
                 )));
             };
-            self.positions.push(frame.positions[i]);
-            self.orientations.push(frame.orientations[i]);
+            self.positions.push(*position);
+            self.orientations.push(*orientation);
         }
         Ok(())
     }

@@ -4,6 +4,9 @@
 //! (`configs/bvh_lafan1_to_<key>.json`); and how a robot argument (a shipped key, an MJCF or a
 //! URDF path) becomes an [`mjcf::Model`].
 
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::path::Path;
 
 use mjcf::Model;
