@@ -71,4 +71,11 @@ def batch(
     )
 
 
-from . import gmr  # noqa: E402  (gmr imports the names above)
+def __getattr__(name: str) -> Any:
+    # `retarget.gmr` is imported on first use (PEP 562): it needs numpy, whose import (about
+    # 0.2 s) a script that only converts files never pays; `Motion`'s arrays import it too.
+    if name == "gmr":
+        import importlib
+
+        return importlib.import_module(f"{__name__}.gmr")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

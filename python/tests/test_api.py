@@ -28,6 +28,15 @@ def test_errors_are_python_exceptions(tmp_path):
     assert "unitree_g1" in retarget.shipped_robots()
 
 
+def test_import_is_light_and_gmr_loads_on_first_use():
+    code = ("import sys, retarget; assert 'numpy' not in sys.modules, 'numpy imported'; "
+            "from retarget.gmr import load_bvh_file; assert retarget.gmr.load_bvh_file is load_bvh_file; "
+            "assert 'numpy' in sys.modules; retarget.gmr.GeneralMotionRetargeting")
+    subprocess.run([sys.executable, "-c", code], check=True)
+    with pytest.raises(AttributeError, match="no_such_name"):
+        retarget.no_such_name
+
+
 def test_robots_and_configs_from_files(root, shared):
     robot = root / "robots/unitree_g1/unitree_g1.xml"
     config = root / "configs/bvh_lafan1_to_unitree_g1.json"

@@ -37,8 +37,9 @@ impl Default for SolveMode {
 /// Tunables of [`SolveMode::Plausible`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlausibleOptions {
-    /// Whether the source's contact phases are detected and the robot's feet planted on the
-    /// floor during them (this plans over the whole clip, so it needs the future).
+    /// Whether the robot's feet are planted on the floor during the source's contact phases
+    /// (this plans over the whole clip, so it needs the future). The phases themselves are
+    /// detected and written in every mode.
     pub planting: Planting,
     pub contact: crate::contact::ContactOptions,
     pub feet: crate::feet::FootPlanOptions,
@@ -64,7 +65,7 @@ pub struct PlausibleOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Planting {
     On,
-    /// No contact detection, no planted foot targets: the targets are GMR's.
+    /// No planted foot targets: the targets are GMR's (the contact labels are still written).
     Off,
 }
 
