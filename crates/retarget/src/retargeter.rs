@@ -593,7 +593,7 @@ impl Stream {
                     solver.set_qpos(&start)?;
                 }
             }
-            let diag = solver.solve_frame(targets, dt);
+            let diag = solver.solve_frame(targets, dt)?;
             if solver.qpos().iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     frame: index,
