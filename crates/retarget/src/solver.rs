@@ -168,6 +168,14 @@ pub struct Solver<'m> {
     /// Whether a general row was active in the last dense solve (then the next step goes
     /// straight to the dense solver).
     rows_bound: bool,
+    /// The constraints' rows are linearised once per frame (and pass), at the first
+    /// constrained step; later steps of the frame re-centre them on the configuration
+    /// reached (`moved`: the sum of the steps since, tangent space). Whether they are made,
+    /// their right-hand sides as made, and where each constraint's rows end.
+    rows_made: bool,
+    row_base: Vec<f64>,
+    row_ends: Vec<usize>,
+    moved: Vec<f64>,
     relaxed_steps: usize,
 }
 
@@ -248,6 +256,10 @@ impl<'m> Solver<'m> {
             point_cols: Vec::with_capacity(nv),
             constraints_on: true,
             rows_bound: false,
+            rows_made: false,
+            row_base: Vec::new(),
+            row_ends: Vec::new(),
+            moved: vec![0.0; nv],
             relaxed_steps: 0,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
@@ -319,6 +331,7 @@ impl<'m> Solver<'m> {
             )));
         }
         self.qpos.copy_from_slice(qpos);
+        self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
         Ok(())
     }
@@ -338,6 +351,7 @@ impl<'m> Solver<'m> {
     pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> Result<FrameDiagnostics, Error> {
         self.check_targets(targets)?;
         self.previous.copy_from_slice(&self.qpos);
+        self.rows_made = false;
         self.qp_failures = 0;
         self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
@@ -426,6 +440,7 @@ impl<'m> Solver<'m> {
             }
         }
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
+        self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
         self.model.kinematics(&self.qpos, &mut self.data);
     }
 
@@ -435,13 +450,29 @@ impl<'m> Solver<'m> {
     /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
     /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
     fn constrained_step(&mut self) -> QpStatus {
-        let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
-        self.dense.clear_rows();
-        let mut ends = Vec::with_capacity(self.constraints.len());
-        for c in &mut self.constraints {
-            c.add_rows(&ctx, &mut self.dense);
-            ends.push(self.dense.num_rows());
+        if self.rows_made {
+            self.dense.shift_rows(&self.row_base, &self.moved);
+        } else {
+            let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
+            self.dense.clear_rows();
+            self.row_ends.clear();
+            for c in &mut self.constraints {
+                c.add_rows(&ctx, &mut self.dense);
+                self.row_ends.push(self.dense.num_rows());
+            }
+            self.row_base.clear();
+            self.row_base.extend_from_slice(self.dense.rhs());
+            self.moved.fill(0.0);
+            self.rows_made = true;
         }
+        let ends = std::mem::take(&mut self.row_ends);
+        let status = self.constrained_solve(&ends);
+        self.row_ends = ends;
+        status
+    }
+
+    /// [`Solver::constrained_step`] once the rows are in `self.dense`.
+    fn constrained_solve(&mut self, ends: &[usize]) -> QpStatus {
         // The box-only solve is cheaper; skip it while the rows keep binding.
         if !self.rows_bound {
             let status = self.qp.solve();
@@ -457,7 +488,7 @@ impl<'m> Solver<'m> {
         let mut status = self.dense.solve();
         if status == QpStatus::Infeasible {
             self.relaxed_steps += 1;
-            status = self.relax(&ends);
+            status = self.relax(ends);
         }
         self.dq.copy_from_slice(&self.dense.x);
         self.rows_bound = (0..self.dense.num_rows()).any(|k| self.dense.row_is_active(k));
@@ -611,6 +642,7 @@ impl<'m> Solver<'m> {
             )));
         }
         self.qpos.copy_from_slice(reference);
+        self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
         let nv = self.model.nv;
         for _ in 0..steps {
@@ -632,6 +664,7 @@ impl<'m> Solver<'m> {
                 break;
             }
             self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
+            self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
             self.model.kinematics(&self.qpos, &mut self.data);
         }
         self.previous.copy_from_slice(&self.qpos);
