@@ -450,7 +450,11 @@ impl<'m> Solver<'m> {
     /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
     /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
     fn constrained_step(&mut self) -> QpStatus {
-        if self.rows_made {
+        // Beyond this (rad or m, any coordinate) from where they were made, the rows are made
+        // again. Held over any move, the linearisation took Fourier N1's walk from 8.9 to
+        // 11.2 cm mean position error; with this bound it is unchanged.
+        const RELINEARISE: f64 = 0.02;
+        if self.rows_made && self.moved.iter().all(|m| m.abs() <= RELINEARISE) {
             self.dense.shift_rows(&self.row_base, &self.moved);
         } else {
             let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
