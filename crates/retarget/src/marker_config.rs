@@ -136,14 +136,7 @@ impl MarkerConfig {
         name: &str,
         human_height: Option<f64>,
     ) -> Result<MarkerMotion, Error> {
-        let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();
-        let frames: Vec<Vec<Option<[f64; 3]>>> = (0..file.points.frame_count())
-            .map(|f| {
-                (0..labels.len())
-                    .map(|p| file.points.get(f, p).map(|pt| pt.position.map(f64::from)))
-                    .collect()
-            })
-            .collect();
+        let (labels, frames) = labelled_points(file);
         let fps = f64::from(file.point_rate());
         let axes = fk::markers::axes_rotation(&self.axes).ok_or_else(|| Error::Config {
             at: format!("{}: `source_axes`", self.source),
@@ -202,6 +195,23 @@ fn labels(v: &Value, key: &str, source: &str) -> Result<Vec<String>, Error> {
         .iter()
         .map(|m| m.as_str().map(str::to_owned).ok_or_else(bad))
         .collect()
+}
+
+/// Per frame and point, a point's position in file units (`None` where it is invalid).
+pub type PointFrames = Vec<Vec<Option<[f64; 3]>>>;
+
+/// A C3D file's point labels (trimmed) and their positions ([`PointFrames`]).
+#[must_use]
+pub fn labelled_points(file: &c3d::C3d) -> (Vec<String>, PointFrames) {
+    let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();
+    let frames = (0..file.points.frame_count())
+        .map(|f| {
+            (0..labels.len())
+                .map(|p| file.points.get(f, p).map(|pt| pt.position.map(f64::from)))
+                .collect()
+        })
+        .collect();
+    (labels, frames)
 }
 
 #[cfg(test)]
