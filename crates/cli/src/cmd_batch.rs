@@ -7,7 +7,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 
 use retarget::writers::{write_motion, Format};
-use retarget::{IkConfig, RetargetOptions};
+use retarget::{IkConfig, MarkerConfig, RetargetOptions, Retargeter};
 
 use crate::batch::{self, ClipResult, Plan, Shard, Summary};
 
@@ -83,13 +83,15 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     if let Some(fps) = args.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
         bail!("--fps {fps}: expected a positive rate");
     }
-    let mut job = Job::load(&robot, args.config.as_deref(), args.human_height, &args.format)?;
-    if let Some(frames) = args.chunk_frames {
-        job.options.chunk = Some(retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in });
-    }
-    if args.gmr {
-        job.options.mode = retarget::SolveMode::Gmr;
-    }
+    let options = RetargetOptions {
+        human_height: args.human_height,
+        chunk: args
+            .chunk_frames
+            .map(|frames| retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in }),
+        mode: if args.gmr { retarget::SolveMode::Gmr } else { retarget::SolveMode::default() },
+        ..RetargetOptions::default()
+    };
+    let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;
     job.fps = args.fps;
     let files = batch::select_shard(batch::walk(&input, &["bvh", "c3d"])?, args.shard);
     let jobs =
@@ -144,18 +146,15 @@ fn print_table(summary: &Summary) {
     }
 }
 
-/// What every clip of a batch shares: the robot, the config source and the options.
+/// What every clip of a batch shares: the retargeter (robot, config choice, options) and
+/// the output settings.
 struct Job {
-    model: mjcf::Model,
-    robot: String,
+    retargeter: Retargeter,
     /// `--config`, read once.
     given: Option<IkConfig>,
-    /// The shipped robot's tuned config.
-    tuned: Option<IkConfig>,
     /// The marker part of `--config`, when it has one (needed by C3D clips).
-    markers: Option<crate::cmd_retarget::MarkerConfig>,
+    markers: Option<MarkerConfig>,
     config_path: Option<PathBuf>,
-    options: RetargetOptions,
     format: Format,
     /// `--fps`: resample every output.
     fps: Option<f64>,
@@ -165,26 +164,23 @@ impl Job {
     fn load(
         robot: &str,
         config: Option<&Path>,
-        human_height: Option<f64>,
+        options: RetargetOptions,
         format: &str,
     ) -> anyhow::Result<Job> {
         let given = config.map(IkConfig::from_file).transpose()?;
-        let tuned = crate::cmd_retarget::shipped_config(robot).transpose()?;
-        let config_path = config;
         let format = crate::cmd_retarget::parse_format(Some(format))?
             .context("an output format is required")?;
-        let markers = config_path
-            .filter(|p| has_marker_bodies(p))
-            .map(crate::cmd_retarget::MarkerConfig::from_file)
-            .transpose()?;
+        let markers =
+            config.filter(|p| has_marker_bodies(p)).map(MarkerConfig::from_file).transpose()?;
+        let mut retargeter = Retargeter::new(robot)?.with_options(options);
+        if let Some(given) = &given {
+            retargeter = retargeter.with_config(given.clone());
+        }
         Ok(Job {
-            model: crate::shipped::robot_model(robot)?,
-            robot: crate::cmd_retarget::robot_label(robot),
+            retargeter,
             given,
-            tuned,
             markers,
-            config_path: config_path.map(Path::to_path_buf),
-            options: RetargetOptions { human_height, ..RetargetOptions::default() },
+            config_path: config.map(Path::to_path_buf),
             format,
             fps: None,
         })
@@ -199,35 +195,28 @@ impl Job {
             self.convert_c3d(src)?
         } else {
             let bvh = bvh::from_path(src)?;
-            let gmr = self.options.mode == retarget::SolveMode::Gmr;
-            let chosen = retarget::derive::choose(
-                &self.model,
-                &self.robot,
-                &bvh,
-                &self.options.fk,
-                self.given.clone(),
-                self.tuned.as_ref(),
-                gmr,
-            )
-            .with_context(|| format!("{}: choosing the IK config", src.display()))?;
-            let (motion, mut diag) =
-                retarget::retarget_bvh(&bvh, &self.model, &chosen.config, &self.options)
-                    .with_context(|| format!("{}: retargeting", src.display()))?;
-            diag.human_inferred =
-                crate::cmd_retarget::with_config(&diag.human_inferred, &chosen.summary);
+            let chosen = self
+                .retargeter
+                .choose_config(&bvh)
+                .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+            let (motion, diag) = self
+                .retargeter
+                .retarget_bvh_with(&bvh, &chosen)
+                .with_context(|| format!("{}: retargeting", src.display()))?;
             (motion, diag, chosen.config)
         };
         let report_options = retarget::report::ReportOptions {
             position_targets: Some(config.position_targets()),
             ..retarget::report::ReportOptions::default()
         };
-        let quality = retarget::report::report(&motion, &self.model, &report_options)?;
+        let quality = self.retargeter.report(&motion, &report_options)?;
+        let model = self.retargeter.model();
         match self.fps {
             Some(fps) => {
-                let resampled = retarget::resample::resample(&motion, &self.model, fps)?;
-                write_motion(dst, &resampled, &self.model, Some(self.format))?;
+                let resampled = retarget::resample::resample(&motion, model, fps)?;
+                write_motion(dst, &resampled, model, Some(self.format))?;
             }
-            None => write_motion(dst, &motion, &self.model, Some(self.format))?,
+            None => write_motion(dst, &motion, model, Some(self.format))?,
         }
         Ok(ClipResult {
             frames: motion.num_frames(),
@@ -252,16 +241,17 @@ impl Job {
                     .map_or(String::new(), |p| format!("; {} has none", p.display()))
             );
         };
-        let (human, height, source) =
-            crate::cmd_retarget::c3d_human_motion(src, markers, self.options.human_height)?;
-        let options = RetargetOptions { human_height: Some(height), ..self.options.clone() };
         let Some(config) = self.given.clone() else {
             bail!("{}: a C3D clip needs --config (a marker config)", src.display());
         };
-        let (motion, mut diag) =
-            crate::cmd_retarget::retarget_human(&human, &self.model, &config, &options)
-                .with_context(|| format!("{}: retargeting", src.display()))?;
-        diag.human_height_source = source;
+        let file = c3d::C3d::from_path(src).with_context(|| format!("{}", src.display()))?;
+        let name = src.display().to_string();
+        let clip = markers.motion(&file, &name, self.retargeter.options().human_height)?;
+        let (motion, mut diag) = self
+            .retargeter
+            .retarget_with(&clip.human, &config, clip.height)
+            .with_context(|| format!("{}: retargeting", src.display()))?;
+        diag.human_height_source = clip.height_source;
         Ok((motion, diag, config))
     }
 }

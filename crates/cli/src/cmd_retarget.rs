@@ -8,10 +8,9 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use clap::Args;
 use retarget::writers::{write_motion, Format};
-use retarget::{ClipDiagnostics, IkConfig, RetargetOptions, RobotMotion, SolveMode};
-
-use crate::shipped;
-use fk::markers::MarkerBody;
+use retarget::{
+    ClipDiagnostics, IkConfig, MarkerConfig, RetargetOptions, Retargeter, RobotMotion, SolveMode,
+};
 
 #[derive(Args, Debug)]
 pub struct MainArgs {
@@ -62,21 +61,9 @@ pub struct MainArgs {
 /// The output formats `--format` accepts (main command and batch).
 pub const FORMATS: [&str; 4] = ["npz", "csv", "pkl", "json"];
 
-/// The default IK config of each shipped robot (`configs/bvh_lafan1_to_<key>.json`).
-pub const SHIPPED_CONFIGS: &[(&str, &str)] = &[
-    ("booster_t1_29dof", include_str!("../../../configs/bvh_lafan1_to_booster_t1_29dof.json")),
-    ("engineai_pm01", include_str!("../../../configs/bvh_lafan1_to_engineai_pm01.json")),
-    ("fourier_n1", include_str!("../../../configs/bvh_lafan1_to_fourier_n1.json")),
-    ("stanford_toddy", include_str!("../../../configs/bvh_lafan1_to_stanford_toddy.json")),
-    ("unitree_g1", include_str!("../../../configs/bvh_lafan1_to_unitree_g1.json")),
-    ("unitree_h1", include_str!("../../../configs/bvh_lafan1_to_unitree_h1.json")),
-];
-
-/// The shipped default config of robot `key`.
+/// The tuned IK config of shipped robot `key` (`configs/bvh_lafan1_to_<key>.json`).
 pub fn shipped_config(key: &str) -> Option<anyhow::Result<IkConfig>> {
-    let (_, text) = SHIPPED_CONFIGS.iter().find(|(k, _)| *k == key)?;
-    let name = format!("configs/bvh_lafan1_to_{key}.json");
-    Some(IkConfig::from_json_str(text, &name).map_err(anyhow::Error::from))
+    retarget::shipped::tuned_config(key).map(|r| r.map_err(anyhow::Error::from))
 }
 
 pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
@@ -89,7 +76,6 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     };
     let format = parse_format(args.format.as_deref())?;
     let output = output_path(&input, args.output.as_deref(), format);
-    let model = shipped::robot_model(&robot)?;
     let started = Instant::now();
     let mode = if args.gmr { SolveMode::Gmr } else { SolveMode::default() };
     let chunk = args
@@ -101,31 +87,36 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         chunk,
         ..RetargetOptions::default()
     };
+    let mut retargeter = Retargeter::new(&robot)?.with_options(options);
     let (motion, diag) = if args.c3d.is_some() {
-        let config = resolve_config(&robot, args.config.as_deref())?;
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
+        let config = IkConfig::from_file(config_path)?;
         let markers = MarkerConfig::from_file(config_path)?;
-        let (human, height, source) = c3d_human_motion(&input, &markers, args.human_height)?;
-        let opts = RetargetOptions { human_height: Some(height), ..options };
-        let (motion, mut diag) = retarget_human(&human, &model, &config, &opts)
+        let file = c3d::C3d::from_path(&input).with_context(|| format!("{}", input.display()))?;
+        let clip = markers.motion(&file, &input.display().to_string(), args.human_height)?;
+        let (motion, mut diag) = retargeter
+            .retarget_with(&clip.human, &config, clip.height)
             .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?;
-        diag.human_height_source = source;
+        diag.human_height_source = clip.height_source;
         (motion, diag)
     } else {
+        if let Some(path) = &args.config {
+            retargeter = retargeter.with_config(IkConfig::from_file(path)?);
+        }
         let bvh =
             crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
-        let chosen =
-            choose_config(&robot, &model, args.config.as_deref(), args.gmr, &bvh, &options.fk)
-                .with_context(|| format!("{}: choosing the IK config", input.display()))?;
-        let (motion, mut diag) = retarget::retarget_bvh(&bvh, &model, &chosen.config, &options)
-            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?;
-        diag.human_inferred = with_config(&diag.human_inferred, &chosen.summary);
-        (motion, diag)
+        let chosen = retargeter
+            .choose_config(&bvh)
+            .with_context(|| format!("{}: choosing the IK config", input.display()))?;
+        retargeter
+            .retarget_bvh_with(&bvh, &chosen)
+            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
     };
+    let model = retargeter.model();
     match args.fps {
         Some(fps) => {
-            let resampled = retarget::resample::resample(&motion, &model, fps)?;
-            write_motion(&output, &resampled, &model, format)?;
+            let resampled = retarget::resample::resample(&motion, model, fps)?;
+            write_motion(&output, &resampled, model, format)?;
             println!(
                 "resampled {} frames at {} fps to {} frames at {fps} fps",
                 motion.num_frames(),
@@ -133,207 +124,16 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
                 resampled.num_frames()
             );
         }
-        None => write_motion(&output, &motion, &model, format)?,
+        None => write_motion(&output, &motion, model, format)?,
     }
     let wall = started.elapsed().as_secs_f64();
     print_summary(&input, &output, &motion, &diag, wall);
     Ok(ExitCode::SUCCESS)
 }
 
-/// [`retarget::retarget_motion`], or its chunked form when `options.chunk` is set (as
-/// [`retarget::retarget_bvh`] does for BVH input).
-pub(crate) fn retarget_human(
-    human: &fk::HumanMotion,
-    model: &mjcf::Model,
-    config: &IkConfig,
-    options: &RetargetOptions,
-) -> Result<(RobotMotion, ClipDiagnostics), retarget::Error> {
-    match options.chunk {
-        Some(chunk) => {
-            retarget::chunked::retarget_motion_chunked(human, model, config, options, chunk)
-        }
-        None => retarget::retarget_motion(human, model, config, options),
-    }
-}
-
-/// The marker part of a marker-driven IK config (keys the IK config itself ignores).
-pub(crate) struct MarkerConfig {
-    bodies: Vec<MarkerBody>,
-    /// `source_axes`, checked.
-    axes: String,
-    metres_per_unit: f64,
-    /// Landmarks for the subject height: top markers, bottom markers, and the fraction of
-    /// the stature the top markers stand at.
-    height: Option<(Vec<String>, Vec<String>, f64)>,
-    /// `subject_height_m`, when the config fixes it.
-    subject_height: Option<f64>,
-}
-
-impl MarkerConfig {
-    pub(crate) fn from_file(path: &Path) -> anyhow::Result<MarkerConfig> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
-        let json: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{}", path.display()))?;
-        let at = |key: &str| format!("{}: `{key}`", path.display());
-        let strings = |v: &serde_json::Value, key: &str| -> anyhow::Result<Vec<String>> {
-            v.as_array()
-                .with_context(|| format!("{}: expected a list of marker labels", at(key)))?
-                .iter()
-                .map(|m| m.as_str().map(str::to_owned).with_context(|| at(key)))
-                .collect()
-        };
-        let table = json.get("marker_bodies").and_then(serde_json::Value::as_object).with_context(
-            || format!("{}: a marker config needs `marker_bodies`", path.display()),
-        )?;
-        let mut bodies = Vec::new();
-        for (name, def) in table {
-            let markers =
-                strings(def.get("markers").with_context(|| at(&format!("{name}.markers")))?, name)?;
-            let frame = match def.get("frame") {
-                None | Some(serde_json::Value::Null) => None,
-                Some(v) => {
-                    let f = strings(v, &format!("{name}.frame"))?;
-                    let [a, b, c]: [String; 3] = f.try_into().map_err(|_| {
-                        anyhow::anyhow!(
-                            "{}: needs exactly three markers",
-                            at(&format!("{name}.frame"))
-                        )
-                    })?;
-                    Some([a, b, c])
-                }
-            };
-            bodies.push(MarkerBody { name: name.clone(), markers, frame });
-        }
-        let axes_name =
-            json.get("source_axes").and_then(serde_json::Value::as_str).unwrap_or("z-up");
-        if fk::markers::axes_rotation(axes_name).is_none() {
-            bail!("{}: `{axes_name}`: expected \"z-up\" or \"y-up\"", at("source_axes"));
-        }
-        let axes = axes_name.to_owned();
-        let metres_per_unit =
-            json.get("marker_units_m").and_then(serde_json::Value::as_f64).unwrap_or(0.001);
-        let height = match json.get("marker_height") {
-            None => None,
-            Some(h) => Some((
-                strings(
-                    h.get("top").with_context(|| at("marker_height.top"))?,
-                    "marker_height.top",
-                )?,
-                strings(
-                    h.get("bottom").with_context(|| at("marker_height.bottom"))?,
-                    "marker_height.bottom",
-                )?,
-                h.get("fraction_of_stature")
-                    .and_then(serde_json::Value::as_f64)
-                    .with_context(|| at("marker_height.fraction_of_stature"))?,
-            )),
-        };
-        let subject_height = json.get("subject_height_m").and_then(serde_json::Value::as_f64);
-        Ok(MarkerConfig { bodies, axes, metres_per_unit, height, subject_height })
-    }
-}
-
-/// Reads a C3D file and builds the virtual marker bodies; returns them with the subject
-/// height and where it came from.
-pub(crate) fn c3d_human_motion(
-    path: &Path,
-    markers: &MarkerConfig,
-    human_height: Option<f64>,
-) -> anyhow::Result<(fk::HumanMotion, f64, String)> {
-    let file = c3d::C3d::from_path(path).with_context(|| format!("{}", path.display()))?;
-    let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();
-    let frames: Vec<Vec<Option<[f64; 3]>>> = (0..file.points.frame_count())
-        .map(|f| {
-            (0..labels.len())
-                .map(|p| file.points.get(f, p).map(|pt| pt.position.map(f64::from)))
-                .collect()
-        })
-        .collect();
-    let fps = f64::from(file.point_rate());
-    let axes = fk::markers::axes_rotation(&markers.axes).context("source_axes")?;
-    let human = fk::markers::marker_motion(
-        &labels,
-        &frames,
-        fps,
-        markers.metres_per_unit,
-        &axes,
-        &markers.bodies,
-    )
-    .with_context(|| format!("{}: marker bodies", path.display()))?;
-    let (height, source) = if let Some(h) = human_height {
-        (h, "given".to_owned())
-    } else if let Some(h) = markers.subject_height {
-        (h, "config subject_height_m".to_owned())
-    } else if let Some((top, bottom, fraction)) = &markers.height {
-        let above = fk::markers::marker_height(
-            &labels,
-            &frames,
-            markers.metres_per_unit,
-            &axes,
-            top,
-            bottom,
-        )
-        .with_context(|| format!("{}: subject height", path.display()))?
-        .with_context(|| format!("{}: height markers never seen", path.display()))?;
-        (above / fraction, format!("markers {} at {fraction} of stature", top.join("+")))
-    } else {
-        bail!("{}: give --human-height (the config has no `marker_height`)", path.display())
-    };
-    if !(height.is_finite() && height > 0.0) {
-        bail!("{}: subject height {height} m is not positive", path.display());
-    }
-    Ok((human, height, source))
-}
-
-/// The IK config for retargeting `bvh` onto `model` ([`retarget::derive::choose`]): the
-/// `--config` file (bound to the skeleton when role-named), GMR's tuned config of a shipped
-/// robot (always with `--gmr`; else when the skeleton has its names and joint frames), or the
-/// config derived from the robot's and the skeleton's roles.
-pub fn choose_config(
-    robot: &str,
-    model: &mjcf::Model,
-    config: Option<&Path>,
-    gmr: bool,
-    bvh: &bvh::Bvh,
-    fk: &fk::FkOptions,
-) -> anyhow::Result<retarget::derive::Chosen> {
-    let given = config.map(IkConfig::from_file).transpose()?;
-    let tuned = shipped_config(robot).transpose()?;
-    let name = robot_label(robot);
-    Ok(retarget::derive::choose(model, &name, bvh, fk, given, tuned.as_ref(), gmr)?)
-}
-
 /// A robot argument as messages name it: the shipped key, or the model file's stem.
 pub fn robot_label(robot: &str) -> String {
-    match Path::new(robot).file_stem() {
-        Some(stem) if robot.contains('.') || robot.contains(std::path::MAIN_SEPARATOR) => {
-            stem.to_string_lossy().into_owned()
-        }
-        _ => robot.to_owned(),
-    }
-}
-
-/// The one-line summary of what was inferred, with the config that was used.
-pub fn with_config(inferred: &str, config: &str) -> String {
-    if inferred.is_empty() {
-        config.to_owned()
-    } else {
-        format!("{inferred}; {config}")
-    }
-}
-
-/// The IK config at `path`, else the shipped default of robot `robot`.
-pub fn resolve_config(robot: &str, path: Option<&Path>) -> anyhow::Result<IkConfig> {
-    match (path, shipped_config(robot)) {
-        (Some(path), _) => Ok(IkConfig::from_file(path)?),
-        (None, Some(config)) => config,
-        (None, None) if !crate::shipped::looks_like_path(robot) => {
-            Err(crate::shipped::unknown_robot(robot))
-        }
-        (None, None) => {
-            bail!("--robot {robot} is a model file, not a shipped robot: give its IK config with --config")
-        }
-    }
+    retarget::shipped::robot_label(robot)
 }
 
 /// `--format NAME` (npz, csv, pkl, json).

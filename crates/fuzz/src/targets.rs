@@ -372,14 +372,7 @@ impl Target for C3dTarget {
         let file = c3d::C3d::from_reader(Cursor::new(input)).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         let _ = file.write(&mut out, c3d::Format::INTEL_FLOAT);
-        let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();
-        let frames: Vec<Vec<Option<[f64; 3]>>> = (0..file.points.frame_count())
-            .map(|f| {
-                (0..labels.len())
-                    .map(|p| file.points.get(f, p).map(|pt| pt.position.map(f64::from)))
-                    .collect()
-            })
-            .collect();
+        let (labels, frames) = retarget::marker_config::labelled_points(&file);
         let bodies: Vec<fk::markers::MarkerBody> = labels
             .chunks(3)
             .enumerate()

@@ -46,7 +46,7 @@ fn bench_solve(c: &mut Criterion) {
         b.iter(|| {
             let mut solver = Solver::new(&model, &stages, SolverOptions::default()).unwrap();
             for t in &targets {
-                std::hint::black_box(solver.solve_frame(t, 1.0 / 30.0));
+                std::hint::black_box(solver.solve_frame(t, 1.0 / 30.0).ok());
             }
         });
     });

@@ -8,6 +8,11 @@
 //! `z + J_z Δq ≥ floor`. The next step re-linearises at the new configuration, so the error
 //! of one step is second order in its length.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: geom, body and dof ids come from the model the constraint was built for (`mjcf::Model`
+// guarantees them in range) and row buffers are sized `nv`.
+#![allow(clippy::indexing_slicing)]
+
 use mjcf::{Data, GeomType, Model};
 use nalgebra::{Matrix3, Vector3};
 

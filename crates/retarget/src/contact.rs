@@ -14,6 +14,11 @@
 //! phases shorter than it are dropped, so one noisy frame neither splits a stance nor makes
 //! a step.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: per-frame buffers are built here with the motion's frame count, which
+// `HumanMotion::validate` checked against its arrays.
+#![allow(clippy::indexing_slicing)]
+
 use fk::HumanMotion;
 use nalgebra::Vector3;
 

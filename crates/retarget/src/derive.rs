@@ -479,20 +479,17 @@ fn middle_hinge(
     let point = |r: Role| roles.roles.get(&r).map(|x| x.point);
     let (u, f) = ((point(mid)? - point(proximal)?), (point(distal)? - point(mid)?));
     let body = roles.body(mid)?;
-    let (j, joint) = model
+    let (a, joint) = model
         .joints
         .iter()
         .enumerate()
         .filter(|(_, j)| j.body == body && j.kind == mjcf::JointType::Hinge)
-        .min_by(|a, b| {
-            let along = |j: usize| data.xaxis[j].dot(&f).abs();
-            along(a.0).total_cmp(&along(b.0))
-        })?;
-    let a = data.xaxis[j];
+        .filter_map(|(j, joint)| Some((*data.xaxis.get(j)?, joint)))
+        .min_by(|a, b| a.0.dot(&f).abs().total_cmp(&b.0.dot(&f).abs()))?;
     let (u, f) = (u - a * a.dot(&u), f - a * a.dot(&f));
     // Turning the distal bone by θ about the axis lays it along the proximal one.
     let theta = a.dot(&f.cross(&u)).atan2(f.dot(&u));
-    Some((a, model.qpos0[joint.qpos_adr] + theta, joint.range?))
+    Some((a, model.qpos0.get(joint.qpos_adr)? + theta, joint.range?))
 }
 
 /// The robot's canonical frames ([`RobotRoles::canonical_frames`]) with each limb's twist
@@ -641,9 +638,12 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
     let (frames, hinges) = limb_frames(model, &data, roles);
     let mut bodies = BTreeMap::new();
     for (role, r) in &roles.roles {
-        let Some(c) = frames.get(role) else { continue };
-        let q = data.xquat[r.body];
-        let offset = q.inverse() * (data.xpos[r.body] - r.point);
+        let (Some(c), Some(q), Some(x)) =
+            (frames.get(role), data.xquat.get(r.body), data.xpos.get(r.body))
+        else {
+            continue;
+        };
+        let offset = q.inverse() * (x - r.point);
         bodies.insert(*role, (r.name.clone(), c.inverse() * q, offset));
     }
     let points: BTreeMap<Role, Vector3<f64>> =
@@ -660,7 +660,7 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
         .roles
         .iter()
         .filter_map(|(role, r)| {
-            Some((*role, frames.get(role)?.inverse() * (data.xpos[r.body] - r.point)))
+            Some((*role, frames.get(role)?.inverse() * (data.xpos.get(r.body)? - r.point)))
         })
         .collect();
     RobotSide {
@@ -762,8 +762,7 @@ fn sole_fit(
         return None;
     }
     let w = SOLE_PRIOR * n as f64;
-    normal[(0, 0)] += w;
-    normal[(1, 1)] += w;
+    normal += nalgebra::Matrix3::from_diagonal(&Vector3::new(w, w, 0.0));
     rhs.x += w * prior.x;
     rhs.y += w * prior.y;
     let fit = normal.try_inverse()? * rhs;
@@ -923,7 +922,7 @@ pub fn bind(
         // human; what the file adds to it (an edit) is kept.
         let origin = match (model.body_id(&e.robot_body), roles.roles.get(&role), frames.get(&role))
         {
-            (Some(b), Some(r), Some(c)) => Some(c.inverse() * (data.xpos[b] - r.point)),
+            (Some(b), Some(r), Some(c)) => data.xpos.get(b).map(|x| c.inverse() * (x - r.point)),
             _ => None,
         };
         let written = config.scale_of(&e.human_body).unwrap_or(1.0);
@@ -1016,7 +1015,11 @@ fn weights(part: Part, robot_has_chest: bool) -> [f64; 4] {
         return own;
     }
     let chest = of(Part::Chest);
-    [0, 1, 2, 3].map(|k| own[k].max(chest[k]))
+    let mut out = own;
+    for (o, c) in out.iter_mut().zip(chest) {
+        *o = o.max(c);
+    }
+    out
 }
 
 fn config_json(rows: &[Row], height: f64, robot_has_chest: bool) -> String {
@@ -1041,7 +1044,8 @@ fn config_json(rows: &[Row], height: f64, robot_has_chest: bool) -> String {
             .iter()
             .map(|r| {
                 let w = weights(r.role.part(), robot_has_chest);
-                (r.body.clone(), r.joint.clone(), w[*table], w[table + 1], r.pos, r.rot)
+                let weight = |k: usize| w.get(k).copied().unwrap_or(0.0);
+                (r.body.clone(), r.joint.clone(), weight(*table), weight(table + 1), r.pos, r.rot)
             })
             .collect();
         write_table(&mut text, k + 1, &entries, k == 1);

@@ -18,6 +18,11 @@
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact
+// labels' lengths, which `plan` clips to it; body and geom ids come from the model.
+#![allow(clippy::indexing_slicing)]
+
 use mjcf::{Data, GeomType, Model};
 use std::ops::Range;
 
@@ -301,9 +306,23 @@ pub fn plan(
             phases(label).into_iter().map(|r| r.start.saturating_sub(lead)..r.end).collect();
         let free: Vec<Pose> = (0..frames).map(|t| targets[t * slots + foot.slot]).collect();
         // The foot orientation each frame's shin target implies (the ankle straight).
-        let shin: Vec<Option<UnitQuaternion<f64>>> = (0..frames)
+        let mut shin: Vec<Option<UnitQuaternion<f64>>> = (0..frames)
             .map(|t| foot.shin.map(|(slot, rel)| quat(&targets[t * slots + slot]) * rel))
             .collect();
+        // The config's shin and foot offsets need not agree about yaw (Toddy's left calf and
+        // toe targets disagree by 180°): turn the shin's by their mean difference over the
+        // clip, so the shin only steadies the foot's yaw and never outvotes it.
+        let (mut s, mut c) = (0.0, 0.0);
+        for (t, q) in shin.iter().enumerate() {
+            if let Some(q) = q {
+                let d = wrap(foot.yaw(q) - foot.yaw(&quat(&free[t])));
+                (s, c) = (s + d.sin(), c + d.cos());
+            }
+        }
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -s.atan2(c));
+        for q in shin.iter_mut().flatten() {
+            *q = turn * *q;
+        }
         let mut ramp = vec![Ramp::default(); frames];
         let mut planted = vec![false; frames];
         for r in &phase_list {

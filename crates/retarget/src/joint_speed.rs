@@ -10,6 +10,8 @@
 //! `joints`. The limits end up in [`mjcf::Joint::velocity_limit`], where the solver and the
 //! report read them.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use std::collections::BTreeMap;
 
 use mjcf::{JointType, Model};

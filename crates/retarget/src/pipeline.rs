@@ -1,5 +1,11 @@
 //! BVH → robot motion: human FK, targets, IK over every frame with warm start.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built here),
+// body ids come from the model; the human motion's sizes are checked by `HumanMotion::validate`
+// first.
+#![allow(clippy::indexing_slicing)]
+
 use std::ops::Range;
 use std::time::Instant;
 
@@ -15,44 +21,8 @@ use crate::lie::Pose;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 use crate::solver::{FrameDiagnostics, PointTask, Solver, SolverOptions, TaskSpec};
 use crate::targets::TargetMap;
-
-/// Everything that can go wrong in the retargeting crate.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum Error {
-    #[error("{path}: cannot read file: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
-    /// A config that does not parse or breaks a rule; `at` is `file:line:column`.
-    #[error("{at}: {message}")]
-    Config { at: String, message: String },
-    /// A robot or human body name in a config that does not exist.
-    #[error("{at}: unknown {side} body `{name}`{}", did_you_mean(nearest))]
-    UnknownName { at: String, side: String, name: String, nearest: Vec<String> },
-    #[error("invalid option: {0}")]
-    InvalidOption(String),
-    /// Human forward kinematics failed (bad BVH content, NaN in the motion, ...).
-    #[error(transparent)]
-    Fk(#[from] fk::Error),
-    /// A robot model in which no two-armed biped standing at `qpos0` is found
-    /// ([`crate::robot_roles`]).
-    #[error("robot `{model}` is not a two-armed biped: {reason}")]
-    NotHumanoid { model: String, reason: String },
-    /// Non-finite target or solver state at a frame.
-    #[error("frame {frame}: {message}")]
-    NonFinite { frame: usize, message: String },
-}
-
-fn did_you_mean(nearest: &[String]) -> String {
-    if nearest.is_empty() {
-        String::new()
-    } else {
-        format!("; nearest: {}", nearest.join(", "))
-    }
-}
+// The crate's error, also reachable here (it was defined in this module).
+pub use crate::Error;
 
 /// Which solve [`retarget_motion`] runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,6 +43,10 @@ impl Default for SolveMode {
 /// Tunables of [`SolveMode::Plausible`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlausibleOptions {
+    /// Whether the robot's feet are planted on the floor during the source's contact phases
+    /// (this plans over the whole clip, so it needs the future). The phases themselves are
+    /// detected and written in every mode.
+    pub planting: Planting,
     pub contact: crate::contact::ContactOptions,
     pub feet: crate::feet::FootPlanOptions,
     /// Every collision geom stays above this height (m): the floor, for the ground
@@ -93,6 +67,14 @@ pub struct PlausibleOptions {
     pub max_extra_steps: usize,
 }
 
+/// Whether [`SolveMode::Plausible`] plants the feet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Planting {
+    On,
+    /// No planted foot targets: the targets are GMR's (the contact labels are still written).
+    Off,
+}
+
 /// Whether the solve keeps the robot's geoms apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SelfCollisionMode {
@@ -111,6 +93,7 @@ pub enum SpeedLimits {
 impl Default for PlausibleOptions {
     fn default() -> Self {
         PlausibleOptions {
+            planting: Planting::On,
             contact: crate::contact::ContactOptions::default(),
             feet: crate::feet::FootPlanOptions::default(),
             floor: 0.0,
@@ -120,6 +103,21 @@ impl Default for PlausibleOptions {
             repair_weight: 1000.0,
             repair_steps: 1,
             max_extra_steps: 10,
+        }
+    }
+}
+
+impl PlausibleOptions {
+    /// The causal part of the default solve: GMR's tasks with the hard constraints (ground,
+    /// self-collision, joint speed), warm-started frame by frame; no foot planting and no
+    /// smoothing, which both need the frames that follow. What streaming
+    /// ([`crate::Retargeter::step`]) runs; a clip solved with it gives the same numbers.
+    #[must_use]
+    pub fn causal() -> PlausibleOptions {
+        PlausibleOptions {
+            planting: Planting::Off,
+            smoothing_passes: 0,
+            ..PlausibleOptions::default()
         }
     }
 }
@@ -142,6 +140,13 @@ impl RetargetOptions {
     #[must_use]
     pub fn gmr() -> RetargetOptions {
         RetargetOptions { mode: SolveMode::Gmr, ..RetargetOptions::default() }
+    }
+
+    /// The default solve's causal part ([`PlausibleOptions::causal`]).
+    #[must_use]
+    pub fn causal() -> RetargetOptions {
+        let mode = SolveMode::Plausible(PlausibleOptions::causal());
+        RetargetOptions { mode, ..RetargetOptions::default() }
     }
 }
 
@@ -315,7 +320,9 @@ impl<'a> Prepared<'a> {
             prepared.contacts = Some(crate::contact::detect(human, points, &contact));
         }
         if let SolveMode::Plausible(plausible) = &options.mode {
-            prepared.plan_feet(plausible);
+            if plausible.planting == Planting::On {
+                prepared.plan_feet(plausible);
+            }
         }
         Ok(prepared)
     }
@@ -345,23 +352,7 @@ impl<'a> Prepared<'a> {
 
     /// A solver for this clip: GMR's, or with the default mode's constraints.
     fn solver(&self) -> Result<Solver<'a>, Error> {
-        let mut options = self.options.solver.clone();
-        if let SolveMode::Plausible(p) = &self.options.mode {
-            options.max_extra_steps = p.max_extra_steps;
-        }
-        let mut solver = Solver::new(self.model, &self.stages, options)?;
-        if let SolveMode::Plausible(p) = &self.options.mode {
-            solver.add_constraint(Box::new(Ground::new(self.model, p.floor)));
-            if p.self_collision == SelfCollisionMode::On {
-                solver.add_constraint(Box::new(SelfCollision::new(self.model)));
-            }
-            if p.speed_limits == SpeedLimits::Robot {
-                let limits: Vec<Option<f64>> =
-                    self.model.joints.iter().map(|j| j.velocity_limit).collect();
-                solver.set_speed_limits(&limits)?;
-            }
-        }
-        Ok(solver)
+        build_solver(self.model, &self.stages, self.options)
     }
 
     /// Solves frames `range`, starting from `qpos0` at frame `range.start − lead_in`
@@ -385,14 +376,13 @@ impl<'a> Prepared<'a> {
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
-        // With a repair pass, the first pass tracks with joint ranges and speed limits only
-        // (box bounds: the fast QP); the repair pass holds the ground and self-collision.
-        if passes > 0 {
-            solver.hold_constraints(false);
-        }
+        // Both passes hold every constraint. (A first pass under box bounds only is 1.4×
+        // faster on the G1, but on robots whose tracking drives links into each other, e.g.
+        // Toddy's hips, one repair step then cannot get out within the speed limits and drops
+        // the self-collision rows: 1402 frames > 1 cm against 14.)
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
-            frames.push(solver.solve_frame(self.frame_targets(f), dt));
+            frames.push(solver.solve_frame(self.frame_targets(f), dt)?);
             if solver.qpos().iter().any(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     frame: f,
@@ -404,14 +394,13 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(p) = &self.options.mode {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
-                solver.hold_constraints(true);
                 solver.set_qpos(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
-                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f));
+                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
                 }
             }
@@ -422,43 +411,13 @@ impl<'a> Prepared<'a> {
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
     }
 
-    /// `qpos0` with the free root moved to frame `f`'s target of the root body and turned to
-    /// its heading (about world z), so that a solve starting far from the origin, or facing
-    /// away from the robot's rest heading, starts where the motion is. `None` without a free
-    /// root or a task on its body.
+    /// The start configuration at frame `f` ([`start_pose`]).
     fn start_pose(&self, f: usize) -> Option<Vec<f64>> {
-        let model = self.model;
-        let root = model.joints.iter().find(|j| j.kind == JointType::Free)?;
-        let &(_, slot) = self.tracked.iter().find(|(b, _)| *b == root.body)?;
-        let target = self.targets.get(f * self.slots + slot)?;
-        let mut q = model.qpos0.clone();
-        let a = root.qpos_adr;
-        let rest = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
-            q[a + 3],
-            q[a + 4],
-            q[a + 5],
-            q[a + 6],
-        ));
-        let goal = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
-            target.quat[0],
-            target.quat[1],
-            target.quat[2],
-            target.quat[3],
-        ));
-        // The heading change that turns the rest forward axis onto the target's.
-        let heading = |r: &nalgebra::UnitQuaternion<f64>| {
-            let f = r * (rest.inverse() * Vector3::x());
-            f.y.atan2(f.x)
-        };
-        let turn = nalgebra::UnitQuaternion::from_axis_angle(
-            &Vector3::z_axis(),
-            heading(&goal) - heading(&rest),
-        );
-        let start = turn * rest;
-        q[a] = target.pos.x;
-        q[a + 1] = target.pos.y;
-        q[a + 3..a + 7].copy_from_slice(&[start.w, start.i, start.j, start.k]);
-        Some(q)
+        start_pose(
+            self.model,
+            &self.tracked,
+            self.targets.get(f * self.slots..(f + 1) * self.slots)?,
+        )
     }
 
     fn frame_targets(&self, f: usize) -> &[Pose] {
@@ -551,6 +510,74 @@ impl<'a> Prepared<'a> {
     }
 }
 
+/// The solver of a clip or a stream: GMR's, or with the default mode's constraints (ground,
+/// self-collision, joint speed limits). The one place both [`retarget_motion`] and
+/// [`crate::Retargeter::step`] build it, so that they solve the same problem.
+pub(crate) fn build_solver<'m>(
+    model: &'m Model,
+    stages: &[Vec<TaskSpec>],
+    options: &RetargetOptions,
+) -> Result<Solver<'m>, Error> {
+    let mut solver_options = options.solver.clone();
+    if let SolveMode::Plausible(p) = &options.mode {
+        solver_options.max_extra_steps = p.max_extra_steps;
+    }
+    let mut solver = Solver::new(model, stages, solver_options)?;
+    if let SolveMode::Plausible(p) = &options.mode {
+        solver.add_constraint(Box::new(Ground::new(model, p.floor)));
+        if p.self_collision == SelfCollisionMode::On {
+            solver.add_constraint(Box::new(SelfCollision::new(model)));
+        }
+        if p.speed_limits == SpeedLimits::Robot {
+            let limits: Vec<Option<f64>> = model.joints.iter().map(|j| j.velocity_limit).collect();
+            solver.set_speed_limits(&limits)?;
+        }
+    }
+    Ok(solver)
+}
+
+/// `qpos0` with the free root moved to one frame's target (`targets`, by slot) of the root
+/// body and turned to its heading (about world z), so that a solve starting far from the
+/// origin, or facing away from the robot's rest heading, starts where the motion is. `None`
+/// without a free root or a task on its body.
+pub(crate) fn start_pose(
+    model: &Model,
+    tracked: &[(usize, usize)],
+    targets: &[Pose],
+) -> Option<Vec<f64>> {
+    let root = model.joints.iter().find(|j| j.kind == JointType::Free)?;
+    let &(_, slot) = tracked.iter().find(|(b, _)| *b == root.body)?;
+    let target = targets.get(slot)?;
+    let mut q = model.qpos0.clone();
+    let a = root.qpos_adr;
+    let rest = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+        q[a + 3],
+        q[a + 4],
+        q[a + 5],
+        q[a + 6],
+    ));
+    let goal = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+        target.quat[0],
+        target.quat[1],
+        target.quat[2],
+        target.quat[3],
+    ));
+    // The heading change that turns the rest forward axis onto the target's.
+    let heading = |r: &nalgebra::UnitQuaternion<f64>| {
+        let f = r * (rest.inverse() * Vector3::x());
+        f.y.atan2(f.x)
+    };
+    let turn = nalgebra::UnitQuaternion::from_axis_angle(
+        &Vector3::z_axis(),
+        heading(&goal) - heading(&rest),
+    );
+    let start = turn * rest;
+    q[a] = target.pos.x;
+    q[a + 1] = target.pos.y;
+    q[a + 3..a + 7].copy_from_slice(&[start.w, start.i, start.j, start.k]);
+    Some(q)
+}
+
 /// The trajectory `qpos` (`frames × nq`) filtered `passes` times by the zero-phase binomial
 /// kernel `[1, 2, 1] / 4` (end frames kept; quaternions renormalised): it damps the
 /// frame-to-frame jitter (the kernel cancels the highest frequency) without lag.
@@ -604,8 +631,30 @@ fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2]
         }
         body = model.bodies[body].parent;
     };
+    // A tracked body welded to the sole (no joint between them: e.g. Toddy's `left_toe_link`
+    // under its sole body `ank_roll_link`) moves rigidly with it and is its foot; otherwise
+    // the nearest tracked ancestor. Walking up from such a sole would plant the shin.
+    let tracked_welded = |sole: usize| {
+        let welded = |b: usize| {
+            let mut b = b;
+            while b != sole {
+                if model.bodies[b].jnt_num > 0 || b == 0 {
+                    return false;
+                }
+                b = model.bodies[b].parent;
+            }
+            true
+        };
+        stages
+            .iter()
+            .flatten()
+            .find(|t| t.body != sole && welded(t.body))
+            .map(|t| (t.body, t.target))
+    };
     soles.map(|sole| {
-        let (body, slot) = tracked_ancestor(sole)?;
+        let tracked = stages.iter().flatten().find(|t| t.body == sole).map(|t| (sole, t.target));
+        let (body, slot) =
+            tracked.or_else(|| tracked_welded(sole)).or_else(|| tracked_ancestor(sole))?;
         let shin = tracked_ancestor(model.bodies[body].parent);
         RobotFoot::new(model, body, sole, slot, shin)
     })
@@ -634,6 +683,6 @@ pub fn task_specs(config: &IkConfig, model: &Model, map: &TargetMap) -> Vec<Vec<
         .collect()
 }
 
-fn finite_pose(p: &Pose) -> bool {
+pub(crate) fn finite_pose(p: &Pose) -> bool {
     p.pos.iter().all(|v| v.is_finite()) && p.quat.iter().all(|v| v.is_finite())
 }

@@ -17,13 +17,18 @@
 //! - **Feet**: the foot height `h` in a frame is the lowest point of the foot's primitive
 //!   collision geoms (sphere, capsule, cylinder, ellipsoid, box on the foot body or its
 //!   descendants) above the ground plane `z = ground_height`, or the height of the foot body's
-//!   origin when it has none. The foot's horizontal velocity `v` is the `gradient` of its body
-//!   origin's x, y. A frame is a **contact** frame when `h < contact_height` and
-//!   `|v| < contact_speed`; a contact frame **slides** when `|v| > slide_speed`. The
-//!   **sliding share** is sliding frames / contact frames. A **contact phase** is a maximal run
-//!   of consecutive contact frames; its **sliding distance** is the horizontal path length of
-//!   the foot origin between consecutive frames of the phase (reported in cm, mean and max
-//!   over phases). **Penetration** in a frame is `max(0, −h)` (cm).
+//!   origin when it has none. The foot's horizontal velocity `v` at frame t is that of its
+//!   **contact point**: the point of the foot body that is lowest at frame t (the body origin
+//!   without geoms), followed as a point fixed in the body over the frames around t (`gradient`
+//!   scheme). A foot rolling over its heel or toes without slipping keeps that point still;
+//!   its body origin moves, which the report counted as sliding until the default solve
+//!   planted rolling feet. A frame is a **contact**
+//!   frame when `h < contact_height` and `|v| < contact_speed`; a contact frame **slides** when
+//!   `|v| > slide_speed`. The **sliding share** is sliding frames / contact frames. A **contact
+//!   phase** is a maximal run of consecutive contact frames; its **sliding distance** is the
+//!   horizontal path length of the contact point between consecutive frames of the phase
+//!   (reported in cm, mean and max over phases). **Penetration** in a frame is `max(0, −h)`
+//!   (cm).
 //! - **Floating**: a frame floats when both feet have `h ≥ contact_height`; the floating
 //!   height of a frame is `max(0, min(h_left, h_right))` (cm).
 //! - **Root height**: z of the first body (the floating base), m.
@@ -75,10 +80,11 @@
 
 use std::fmt;
 
+use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::motion::RobotMotion;
-use crate::writers::{body_poses, check_motion, gradient_rows, BodyPoses, Error};
+use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses, Error};
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]
@@ -357,7 +363,10 @@ pub fn report(
     let frames = motion.num_frames();
     let heights = feet.map(|f| foot_heights(motion, model, f, opts.ground_height));
     let feet_reports: Vec<FootReport> = (0..2)
-        .map(|i| foot_report(model, &poses, feet[i], &heights[i].0, heights[i].1, motion.fps, opts))
+        .map(|i| {
+            let (h, low, from_geoms) = &heights[i];
+            foot_report(model, &poses, feet[i], h, low, *from_geoms, motion.fps, opts)
+        })
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
     let (ground_penetration, self_collision) = collisions(motion, model, opts);
@@ -579,13 +588,14 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
     }
 }
 
-/// Per frame foot height above the ground, and whether it comes from geoms.
+/// Per frame foot height above the ground, the lowest point of the foot (world; the body
+/// origin without geoms), and whether they come from geoms.
 fn foot_heights(
     motion: &RobotMotion,
     model: &mjcf::Model,
     foot: usize,
     ground: f64,
-) -> (Vec<f64>, bool) {
+) -> (Vec<f64>, Vec<Vector3<f64>>, bool) {
     let in_foot = |mut b: usize| loop {
         if b == foot {
             return true;
@@ -599,43 +609,47 @@ fn foot_heights(
         .filter(|&g| in_foot(model.geoms[g].body) && model.geoms[g].kind.is_primitive())
         .collect();
     let mut data = mjcf::Data::new(model);
-    let heights = (0..motion.num_frames())
+    let lowest: Vec<Vector3<f64>> = (0..motion.num_frames())
         .map(|t| {
             model.kinematics(motion.frame(t), &mut data);
-            let lowest = geoms
+            geoms
                 .iter()
                 .filter_map(|&g| mjcf::geom_lowest_point(model, &data, g))
-                .map(|p| p.z)
-                .fold(f64::INFINITY, f64::min);
-            if lowest.is_finite() {
-                lowest
-            } else {
-                data.xpos[foot].z
-            }
+                .min_by(|a, b| a.z.total_cmp(&b.z))
+                .unwrap_or(data.xpos[foot])
         })
-        .map(|z| z - ground)
         .collect();
-    (heights, !geoms.is_empty())
+    let heights = lowest.iter().map(|p| p.z - ground).collect();
+    (heights, lowest, !geoms.is_empty())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn foot_report(
     model: &mjcf::Model,
     poses: &BodyPoses,
     foot: usize,
     heights: &[f64],
+    lowest: &[Vector3<f64>],
     from_geoms: bool,
     fps: f64,
     opts: &ReportOptions,
 ) -> FootReport {
     let frames = heights.len();
-    let xy: Vec<f64> = (0..frames)
-        .flat_map(|t| {
-            let p = poses.pos(t, foot - 1);
-            [p.x, p.y]
+    // The contact point: the foot's lowest point at frame t, fixed in the foot body. Its
+    // world position at frame u, and its horizontal velocity by numpy's gradient scheme.
+    let local: Vec<Vector3<f64>> = (0..frames)
+        .map(|t| poses.quat(t, foot - 1).inverse() * (lowest[t] - poses.pos(t, foot - 1)))
+        .collect();
+    let at = |u: usize, t: usize| poses.pos(u, foot - 1) + poses.quat(u, foot - 1) * local[t];
+    let speed: Vec<f64> = (0..frames)
+        .map(|t| match gradient_pair(t, frames) {
+            Some((a, b)) => {
+                let d = (at(b, t) - at(a, t)) * fps / (b - a) as f64;
+                d.x.hypot(d.y)
+            }
+            None => 0.0,
         })
         .collect();
-    let vel = gradient_rows(&xy, 2, 1.0 / fps);
-    let speed: Vec<f64> = vel.chunks_exact(2).map(|v| v[0].hypot(v[1])).collect();
     let contact: Vec<bool> = (0..frames)
         .map(|t| heights[t] < opts.contact_height && speed[t] < opts.contact_speed)
         .collect();
@@ -650,7 +664,8 @@ fn foot_report(
         }
         let mut dist = 0.0;
         while t + 1 < frames && contact[t + 1] {
-            dist += (xy[2 * t + 2] - xy[2 * t]).hypot(xy[2 * t + 3] - xy[2 * t + 1]);
+            let d = at(t + 1, t) - at(t, t);
+            dist += d.x.hypot(d.y);
             t += 1;
         }
         slides.push(dist * 100.0);

@@ -10,6 +10,8 @@
 //! camelCase boundaries: `J03_KNEE_PITCH_L` → `j 03 knee pitch l`, `hipPitchLeft` →
 //! `hip pitch left`, `leg_l1_link` → `leg l 1 link`, `Left_Hip_Pitch` → `left hip pitch`.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 use fk::Part;
 
 /// Tokens that mark the left side (`left_knee_link`, `L_ANKLE`, `LINK_HIP_PITCH_L`,
@@ -87,7 +89,7 @@ pub fn names_part(name: &str, part: Part) -> bool {
         return false;
     };
     let t = tokens(name);
-    let pairs = t.windows(2).map(|w| format!("{}{}", w[0], w[1]));
+    let pairs = t.iter().zip(t.iter().skip(1)).map(|(a, b)| format!("{a}{b}"));
     t.iter().cloned().chain(pairs).any(|w| words.contains(&w.as_str()))
 }
 

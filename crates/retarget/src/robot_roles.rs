@@ -45,6 +45,11 @@
 //! pelvis the midpoint of the two hip points, for the chest its body's origin, for an end
 //! body without a joint its origin.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: body, joint and geom ids come from the `mjcf::Model` being recognised, whose loader
+// guarantees parents, addresses and geom bodies in range.
+#![allow(clippy::indexing_slicing)]
+
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 

@@ -17,12 +17,21 @@
 //! most `max_extra_steps` more. The first frame starts from `qpos0`, every later one from
 //! the previous solution.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: buffers are sized from the model (`nq`, `nv`, bodies) in `Solver::new`, which checks
+// the task bodies; `solve_frame`/`errors` check the target slots; the model's own ids (parents,
+// dof and qpos addresses) are in range by `mjcf::Model`'s construction.
+#![allow(clippy::indexing_slicing)]
+
 use mjcf::{Data, JointType, Model};
 
 use crate::constraints::{Constraint, StepContext};
 use crate::lie::{self, Pose};
 use crate::qp::{BoxQp, DenseQp, QpStatus};
 use crate::Error;
+
+/// Fraction of a joint speed limit the solver allows itself ([`Solver::set_speed_limits`]).
+const SPEED_MARGIN: f64 = 0.999;
 
 /// Tunables of the solver. [`Default`] reproduces GMR.
 #[derive(Debug, Clone, PartialEq)]
@@ -159,6 +168,14 @@ pub struct Solver<'m> {
     /// Whether a general row was active in the last dense solve (then the next step goes
     /// straight to the dense solver).
     rows_bound: bool,
+    /// The constraints' rows are linearised once per frame (and pass), at the first
+    /// constrained step; later steps of the frame re-centre them on the configuration
+    /// reached (`moved`: the sum of the steps since, tangent space). Whether they are made,
+    /// their right-hand sides as made, and where each constraint's rows end.
+    rows_made: bool,
+    row_base: Vec<f64>,
+    row_ends: Vec<usize>,
+    moved: Vec<f64>,
     relaxed_steps: usize,
 }
 
@@ -239,6 +256,10 @@ impl<'m> Solver<'m> {
             point_cols: Vec::with_capacity(nv),
             constraints_on: true,
             rows_bound: false,
+            rows_made: false,
+            row_base: Vec::new(),
+            row_ends: Vec::new(),
+            moved: vec![0.0; nv],
             relaxed_steps: 0,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
@@ -310,6 +331,7 @@ impl<'m> Solver<'m> {
             )));
         }
         self.qpos.copy_from_slice(qpos);
+        self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
         Ok(())
     }
@@ -322,8 +344,14 @@ impl<'m> Solver<'m> {
 
     /// Solves one frame from the current configuration. `targets` are indexed by the task
     /// specs' `target`; `dt` (seconds per frame) is used by `max_joint_speed` only.
-    pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> FrameDiagnostics {
+    ///
+    /// # Errors
+    /// [`Error::InvalidOption`] when `targets` is shorter than the task specs' largest
+    /// `target` slot.
+    pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> Result<FrameDiagnostics, Error> {
+        self.check_targets(targets)?;
         self.previous.copy_from_slice(&self.qpos);
+        self.rows_made = false;
         self.qp_failures = 0;
         self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
@@ -334,7 +362,7 @@ impl<'m> Solver<'m> {
             error = e;
         }
         let (pos_error, rot_error) = self.tracking_errors(targets);
-        FrameDiagnostics {
+        Ok(FrameDiagnostics {
             steps,
             error,
             pos_error,
@@ -342,7 +370,7 @@ impl<'m> Solver<'m> {
             at_limit: self.at_limit(),
             qp_failures: self.qp_failures,
             relaxed_steps: self.relaxed_steps,
-        }
+        })
     }
 
     fn solve_stage(&mut self, s: usize, targets: &[Pose], dt: f64) -> (usize, f64) {
@@ -412,6 +440,7 @@ impl<'m> Solver<'m> {
             }
         }
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
+        self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
         self.model.kinematics(&self.qpos, &mut self.data);
     }
 
@@ -421,13 +450,33 @@ impl<'m> Solver<'m> {
     /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
     /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
     fn constrained_step(&mut self) -> QpStatus {
-        let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
-        self.dense.clear_rows();
-        let mut ends = Vec::with_capacity(self.constraints.len());
-        for c in &mut self.constraints {
-            c.add_rows(&ctx, &mut self.dense);
-            ends.push(self.dense.num_rows());
+        // Beyond this (rad or m, any coordinate) from where they were made, the rows are made
+        // again. Held over any move, the linearisation took Fourier N1's walk from 8.9 to
+        // 11.2 cm mean position error; with this bound it is unchanged.
+        const RELINEARISE: f64 = 0.02;
+        if self.rows_made && self.moved.iter().all(|m| m.abs() <= RELINEARISE) {
+            self.dense.shift_rows(&self.row_base, &self.moved);
+        } else {
+            let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
+            self.dense.clear_rows();
+            self.row_ends.clear();
+            for c in &mut self.constraints {
+                c.add_rows(&ctx, &mut self.dense);
+                self.row_ends.push(self.dense.num_rows());
+            }
+            self.row_base.clear();
+            self.row_base.extend_from_slice(self.dense.rhs());
+            self.moved.fill(0.0);
+            self.rows_made = true;
         }
+        let ends = std::mem::take(&mut self.row_ends);
+        let status = self.constrained_solve(&ends);
+        self.row_ends = ends;
+        status
+    }
+
+    /// [`Solver::constrained_step`] once the rows are in `self.dense`.
+    fn constrained_solve(&mut self, ends: &[usize]) -> QpStatus {
         // The box-only solve is cheaper; skip it while the rows keep binding.
         if !self.rows_bound {
             let status = self.qp.solve();
@@ -443,7 +492,7 @@ impl<'m> Solver<'m> {
         let mut status = self.dense.solve();
         if status == QpStatus::Infeasible {
             self.relaxed_steps += 1;
-            status = self.relax(&ends);
+            status = self.relax(ends);
         }
         self.dq.copy_from_slice(&self.dense.x);
         self.rows_bound = (0..self.dense.num_rows()).any(|k| self.dense.row_is_active(k));
@@ -597,6 +646,7 @@ impl<'m> Solver<'m> {
             )));
         }
         self.qpos.copy_from_slice(reference);
+        self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
         let nv = self.model.nv;
         for _ in 0..steps {
@@ -618,6 +668,7 @@ impl<'m> Solver<'m> {
                 break;
             }
             self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
+            self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
             self.model.kinematics(&self.qpos, &mut self.data);
         }
         self.previous.copy_from_slice(&self.qpos);
@@ -625,9 +676,24 @@ impl<'m> Solver<'m> {
     }
 
     /// Tracking errors at the current configuration (as in [`FrameDiagnostics`]).
-    #[must_use]
-    pub fn errors(&self, targets: &[Pose]) -> (Vec<f64>, Vec<f64>) {
-        self.tracking_errors(targets)
+    ///
+    /// # Errors
+    /// As [`Solver::solve_frame`].
+    pub fn errors(&self, targets: &[Pose]) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        self.check_targets(targets)?;
+        Ok(self.tracking_errors(targets))
+    }
+
+    /// `targets` has a pose for every task's and point task's target slot.
+    fn check_targets(&self, targets: &[Pose]) -> Result<(), Error> {
+        let needed = self.stages.iter().flatten().map(|t| t.spec.target + 1).max().unwrap_or(0);
+        if targets.len() < needed {
+            return Err(Error::InvalidOption(format!(
+                "the tasks need {needed} target poses, {} were given",
+                targets.len()
+            )));
+        }
+        Ok(())
     }
 
     /// Joint-range bounds on Δq, intersected with the speed limits (per joint, or the global
@@ -637,7 +703,11 @@ impl<'m> Solver<'m> {
         self.qp.ub.fill(f64::INFINITY);
         let gain = self.options.limit_gain;
         let global = self.options.max_joint_speed.filter(|v| v.is_finite() && *v > 0.0);
-        let speed = |dof: usize| self.dof_speed[dof].or(global).filter(|_| dt > 0.0);
+        // Aim 0.1 % inside the limit: the report's finite differences of the written
+        // trajectory should not find a joint at 1.000001× its limit.
+        let speed = |dof: usize| {
+            self.dof_speed[dof].or(global).filter(|_| dt > 0.0).map(|v| v * SPEED_MARGIN)
+        };
         for l in &self.limits {
             let q = self.qpos[l.qpos];
             let mut lb = -(gain * (q - l.range[0]));

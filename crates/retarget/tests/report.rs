@@ -131,6 +131,54 @@ fn check_known_slide(model: &mjcf::Model) {
     assert_eq!(rep.feet[0].contact_phases, 2);
 }
 
+/// The whole robot pitches forward about the front bottom edge of its soles (heels up, as a
+/// foot rolling onto its toes): the feet's contact points stay where they are while the
+/// ankles move at over 0.1 m/s. Nothing slides.
+#[test]
+fn a_foot_rolling_over_its_toes_does_not_slide() {
+    let model = repo_g1();
+    let z = standing_height(&model, 0.0);
+    let mut data = mjcf::Data::new(&model);
+    let mut q0 = model.qpos0.clone();
+    q0[2] = z;
+    model.kinematics(&q0, &mut data);
+    let sole = model.geom_id("left_sole").unwrap();
+    let (c, r, s) = (data.geom_xpos[sole], data.geom_xmat[sole], model.geoms[sole].size);
+    // The front bottom edge of the box sole (x forward at rest), on the floor.
+    let front = (0..3).map(|i| s[0] * r[(0, i)].abs()).sum::<f64>();
+    let pivot = Vector3::new(c.x + front, 0.0, 0.0);
+    let mut qpos = Vec::new();
+    for t in 0..FRAMES {
+        // Still, then 0 → 0.6 rad in 10 frames (1.8 rad/s), then still.
+        let angle = 0.6 * ((t as f64 - 10.0) / 10.0).clamp(0.0, 1.0);
+        let turn = nalgebra::UnitQuaternion::from_axis_angle(&Vector3::y_axis(), angle);
+        let root = Vector3::new(q0[0], q0[1], q0[2]);
+        let moved = pivot + turn * (root - pivot);
+        let mut q = q0.clone();
+        q[..3].copy_from_slice(moved.as_slice());
+        q[3..7].copy_from_slice(&[turn.w, turn.i, turn.j, turn.k]);
+        qpos.extend(q);
+    }
+    let rep =
+        report(&motion_from(&model, qpos.clone()), &model, &ReportOptions::default()).unwrap();
+    let ankle = model.body_id("left_ankle_roll_link").unwrap();
+    let origin_speed = {
+        let (a, b) = (14, 16);
+        let mut at = |t: usize| {
+            model.kinematics(&qpos[t * model.nq..(t + 1) * model.nq], &mut data);
+            data.xpos[ankle]
+        };
+        let d = at(b) - at(a);
+        d.x.hypot(d.y) * FPS / 2.0
+    };
+    assert!(origin_speed > 0.1, "the ankle moves at {origin_speed} m/s");
+    for foot in &rep.feet {
+        assert!(foot.contact_frames > FRAMES / 2, "{foot:?}");
+        assert_eq!(foot.sliding_frames, 0, "{foot:?}");
+        assert!(foot.slide_per_phase_cm_max < 0.5, "{foot:?}");
+    }
+}
+
 #[test]
 fn penetration_and_floating() {
     let Some(model) = g1() else { return };

@@ -79,7 +79,7 @@ fn recovers_own_fk_pose() {
         let mut solver = Solver::new(&model, std::slice::from_ref(&tasks), options).unwrap();
         let mut last = f64::INFINITY;
         for _ in 0..300 {
-            last = solver.solve_frame(&targets, 1.0 / 30.0).error;
+            last = solver.solve_frame(&targets, 1.0 / 30.0).unwrap().error;
         }
         assert!(last < 1e-6, "remaining error {last}");
         let back = poses_of(&model, solver.qpos(), &bodies);
@@ -110,7 +110,7 @@ fn out_of_range_target_stops_at_the_limit() {
     let mut solver = Solver::new(&model, &[tasks], SolverOptions::default()).unwrap();
     let mut last = None;
     for _ in 0..100 {
-        let d = solver.solve_frame(&targets, 1.0 / 30.0);
+        let d = solver.solve_frame(&targets, 1.0 / 30.0).unwrap();
         let qe = solver.qpos()[adr];
         assert!(qe <= hi && qe >= lo, "elbow {qe} outside [{lo}, {hi}]");
         last = Some(d);
@@ -132,7 +132,7 @@ fn max_joint_speed_bounds_every_frame() {
     let mut solver = Solver::new(&model, &[tasks], options).unwrap();
     for _ in 0..5 {
         let before = solver.qpos().to_vec();
-        solver.solve_frame(&targets, 0.1);
+        solver.solve_frame(&targets, 0.1).unwrap();
         for j in model.joints.iter().filter(|j| j.kind == JointType::Hinge) {
             let moved = (solver.qpos()[j.qpos_adr] - before[j.qpos_adr]).abs();
             assert!(moved <= 0.1 + 1e-12, "{} moved {moved}", j.name);
@@ -203,7 +203,7 @@ fn root_position_is_in_metres_and_far_targets_stay_finite() {
     let mut solver =
         Solver::new(&model, std::slice::from_ref(&tasks), SolverOptions::default()).unwrap();
     for _ in 0..30 {
-        solver.solve_frame(&[target], 1.0 / 30.0);
+        solver.solve_frame(&[target], 1.0 / 30.0).unwrap();
     }
     let q = solver.qpos();
     let root = Vector3::new(q[0], q[1], q[2]);
@@ -211,7 +211,7 @@ fn root_position_is_in_metres_and_far_targets_stay_finite() {
     // A target a kilometre away: one damped step, finite, no QP failure.
     let far = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(1e3, -1e3, 1e3) };
     let mut solver = Solver::new(&model, &[tasks], SolverOptions::default()).unwrap();
-    let d = solver.solve_frame(&[far], 1.0 / 30.0);
+    let d = solver.solve_frame(&[far], 1.0 / 30.0).unwrap();
     assert!(solver.qpos().iter().all(|v| v.is_finite()));
     assert_eq!(d.qp_failures, 0);
 }

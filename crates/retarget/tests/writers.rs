@@ -101,7 +101,7 @@ fn bad_motions_are_typed_errors_and_write_nothing() {
     let mut motion = smooth_motion(&model, 2);
     motion.qpos[3 * model.nq + 9] = f64::NAN;
     let err = write_motion(&dir.join("a.csv"), &motion, &model, None).unwrap_err();
-    assert!(matches!(err, Error::NonFinite { frame: 3, index: 9, .. }), "{err}");
+    assert!(matches!(err, Error::NonFiniteQpos { frame: 3, index: 9, .. }), "{err}");
     let mut motion = smooth_motion(&model, 2);
     motion.nq -= 1;
     let err = write_motion(&dir.join("a.npz"), &motion, &model, None).unwrap_err();
@@ -110,7 +110,7 @@ fn bad_motions_are_typed_errors_and_write_nothing() {
         write_motion(&dir.join("a.txt"), &smooth_motion(&model, 2), &model, None).unwrap_err();
     assert!(matches!(err, Error::UnknownFormat { .. }), "{err}");
     let err = write_motion(&dir.join("missing/a.npz"), &smooth_motion(&model, 2), &model, None);
-    assert!(matches!(err, Err(Error::Io { .. })));
+    assert!(matches!(err, Err(Error::File { .. })));
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
 }
 

@@ -12,6 +12,12 @@
 //! of an unconstrained solution). The unconstrained solution is tried first, which is the
 //! whole job when no limit is active. All buffers are allocated once in [`BoxQp::new`].
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: dense linear algebra on buffers sized `n` in `BoxQp::new`; every index is below `n`
+// (or `n·n`) by construction, and the public methods take no indices but `is_bound`, which uses
+// `get`.
+#![allow(clippy::indexing_slicing)]
+
 /// Where a variable sits in the working set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum State {

@@ -6,6 +6,8 @@
 //!   active-set method. The default solve uses it for the ground, self-collision, contact and
 //!   joint-speed constraints.
 
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
 mod boxed;
 mod dual;
 

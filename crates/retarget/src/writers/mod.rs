@@ -21,12 +21,12 @@ mod pickle;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::motion::RobotMotion;
 
-pub(crate) use derived::{angular_velocity, body_poses, gradient_rows, BodyPoses};
+pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
 
 /// Output formats, chosen by file extension.
@@ -70,22 +70,9 @@ impl Format {
     }
 }
 
-/// Errors of the writers, the `.npz` reader and the quality report.
-#[derive(Debug, thiserror::Error)]
-pub enum Error {
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("{}: unknown output format (expected .npz, .csv, .pkl or .json)", path.display())]
-    UnknownFormat { path: PathBuf },
-    #[error("motion does not fit the robot model: {0}")]
-    Mismatch(String),
-    #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
-    NonFinite { frame: usize, index: usize, value: f64 },
-    #[error("{}: {message}", path.display())]
-    Read { path: PathBuf, message: String },
-    #[error("{0}")]
-    Options(String),
-}
+/// Errors of the writers, the `.npz` reader and the quality report: the crate's one
+/// [`crate::Error`].
+pub use crate::Error;
 
 /// Writes `motion` to `path` in `format` (by default the one of the extension), atomically.
 ///
@@ -139,6 +126,16 @@ pub fn write_npz(path: &Path, arrays: &[(&str, npy::Array)]) -> Result<(), Error
     write_atomically(path, |w| npz::write_npz(w, arrays))
 }
 
+/// The arrays [`write_motion`] puts in an `.npz`, in file order, by key (checked as
+/// `write_motion` checks): what the Python package hands over as numpy arrays.
+pub fn npz_arrays(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+) -> Result<Vec<(&'static str, npy::Array)>, Error> {
+    check_motion(motion, model)?;
+    Ok(npz::motion_arrays(motion, model))
+}
+
 /// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
 /// `root_rot` use it. The only place where our files change quaternion order.
 #[must_use]
@@ -168,7 +165,7 @@ pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<
     if let Some(i) = motion.qpos.iter().position(|v| !v.is_finite()) {
         let (frame, index) = (i / motion.nq, i % motion.nq);
         let value = motion.qpos.get(i).copied().unwrap_or(f64::NAN);
-        return Err(Error::NonFinite { frame, index, value });
+        return Err(Error::NonFiniteQpos { frame, index, value });
     }
     if let Some(t) = &motion.targets {
         let expected = motion.num_frames() * t.body_names.len();
@@ -221,7 +218,7 @@ pub fn write_atomically<F>(path: &Path, fill: F) -> Result<(), Error>
 where
     F: FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 {
-    let io_error = |source| Error::Io { path: path.to_path_buf(), source };
+    let io_error = |source| Error::File { path: path.to_path_buf(), source };
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
     let tmp = path.with_file_name(format!(".{name}.tmp-{}-{n}", std::process::id()));

@@ -92,7 +92,8 @@ const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// Every `<key>.npy` of an `.npz`, by key. Allocations are bounded by the file's size.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
-    let file = File::open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let file =
+        File::open(path).map_err(|source| Error::File { path: path.to_path_buf(), source })?;
     read_npz_from(file, path)
 }
 
@@ -102,7 +103,7 @@ fn read_npz_from<R: Read + Seek>(
     path: &Path,
 ) -> Result<BTreeMap<String, Array>, Error> {
     let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
-    let io_error = |source| Error::Io { path: path.to_path_buf(), source };
+    let io_error = |source| Error::File { path: path.to_path_buf(), source };
     // The archive's real length: the only size in it that the file cannot lie about.
     let file_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io_error)?;
     reader.seek(std::io::SeekFrom::Start(0)).map_err(io_error)?;

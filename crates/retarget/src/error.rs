@@ -1,0 +1,99 @@
+//! The one error type of the crate: configs, robots, solving, writing and reading motions.
+//! The errors of the crates below (`bvh`, `c3d`, `fk`, `mjcf`) convert into it with `?`.
+
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in the retargeting crate.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A config (or other input text) that could not be read.
+    #[error("{path}: cannot read file: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file the writers or the `.npz` reader could not create, write or open.
+    #[error("{}: {source}", path.display())]
+    File {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A config that does not parse or breaks a rule; `at` is `file:line:column`.
+    #[error("{at}: {message}")]
+    Config { at: String, message: String },
+    /// A robot or human body name in a config that does not exist.
+    #[error("{at}: unknown {side} body `{name}`{}", did_you_mean(nearest))]
+    UnknownName { at: String, side: String, name: String, nearest: Vec<String> },
+    /// A robot argument that is neither a shipped robot nor a model file; `nearest` is the
+    /// shipped robot whose name is close, if one is.
+    #[error(
+        "unknown robot \"{name}\": not a shipped robot ({}) nor an MJCF (.xml) or URDF (.urdf) file{}",
+        shipped.join(", "),
+        nearest.as_ref().map_or(String::new(), |k| format!("; did you mean {k}?"))
+    )]
+    UnknownRobot { name: String, shipped: Vec<String>, nearest: Option<String> },
+    /// An error about one input file, with its path.
+    #[error("{path}: {source}")]
+    InFile {
+        path: String,
+        #[source]
+        source: Box<Error>,
+    },
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+    /// Human forward kinematics failed (bad BVH content, NaN in the motion, ...).
+    #[error(transparent)]
+    Fk(#[from] fk::Error),
+    /// A BVH file that does not parse.
+    #[error(transparent)]
+    Bvh(#[from] bvh::Error),
+    /// Virtual marker bodies that cannot be built from a C3D file (`context` names the file
+    /// and the step).
+    #[error("{context}: {source}")]
+    Markers {
+        context: String,
+        #[source]
+        source: fk::markers::MarkerError,
+    },
+    /// A C3D file that does not parse.
+    #[error(transparent)]
+    C3d(#[from] c3d::Error),
+    /// A robot model (MJCF or URDF) that does not compile.
+    #[error(transparent)]
+    Mjcf(#[from] mjcf::Error),
+    /// A robot model in which no two-armed biped standing at `qpos0` is found
+    /// ([`crate::robot_roles`]).
+    #[error("robot `{model}` is not a two-armed biped: {reason}")]
+    NotHumanoid { model: String, reason: String },
+    /// Non-finite target or solver state at a frame.
+    #[error("frame {frame}: {message}")]
+    NonFinite { frame: usize, message: String },
+    /// A motion handed to a writer with a non-finite `qpos` entry.
+    #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
+    NonFiniteQpos { frame: usize, index: usize, value: f64 },
+    #[error("{}: unknown output format (expected .npz, .csv, .pkl or .json)", path.display())]
+    UnknownFormat { path: PathBuf },
+    /// A motion that does not belong to the robot model it is written or measured with.
+    #[error("motion does not fit the robot model: {0}")]
+    Mismatch(String),
+    /// An `.npz` (or other motion file) whose content is not what we write.
+    #[error("{}: {message}", path.display())]
+    Read { path: PathBuf, message: String },
+    /// A report or writer option that does not fit the model.
+    #[error("{0}")]
+    Options(String),
+}
+
+fn did_you_mean(nearest: &[String]) -> String {
+    if nearest.is_empty() {
+        String::new()
+    } else {
+        format!("; nearest: {}", nearest.join(", "))
+    }
+}

@@ -1,0 +1,107 @@
+//! The default (physically plausible) solve against GMR's on the LAFAN1 takes (G1, with the
+//! published joint speed limits): the issue-11 metrics from [`retarget::report::report`].
+//! Measured on whole takes by `scripts/quality-table` (README); here on a slice of each so
+//! that the test stays short.
+
+#[path = "../../../tests/support/shared.rs"]
+mod shared;
+
+use retarget::joint_speed::JointSpeedLimits;
+use retarget::report::{report, QualityReport, ReportOptions};
+use retarget::{retarget_motion, IkConfig, RetargetOptions};
+
+fn g1() -> mjcf::Model {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
+    let path = root.join("robots/unitree_g1/joint_speed_limits.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let origin = path.display().to_string();
+    JointSpeedLimits::from_json_str(&text, &origin).unwrap().apply(&mut model, &origin).unwrap();
+    model
+}
+
+/// Frames `range` of a shared LAFAN1 take, retargeted onto the G1 with `base`, and its report.
+fn solve(
+    take: &str,
+    range: std::ops::Range<usize>,
+    base: RetargetOptions,
+) -> Option<QualityReport> {
+    let path = shared::shared_file(&format!("data/bvh/{take}"))?;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model = g1();
+    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let bvh = bvh::from_path(&path).unwrap();
+    let (full, human_report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
+    let nb = full.num_bodies();
+    let n = range.len();
+    let human = fk::HumanMotion {
+        num_frames: n,
+        positions: full.positions[range.start * nb..range.end * nb].to_vec(),
+        orientations: full.orientations[range.start * nb..range.end * nb].to_vec(),
+        ..full
+    };
+    let options = RetargetOptions { human_height: Some(human_report.height), ..base };
+    let (motion, _) = retarget_motion(&human, &model, &config, &options).unwrap();
+    assert!(motion.contacts.is_some(), "both solves carry the source's contacts");
+    Some(report(&motion, &model, &ReportOptions::default()).unwrap())
+}
+
+fn mean_jitter(r: &QualityReport) -> f64 {
+    r.joints.iter().map(|j| j.jitter).sum::<f64>() / r.joints.len() as f64
+}
+
+fn mean_pos_error_cm(r: &QualityReport) -> f64 {
+    let tracking = r.tracking.as_ref().unwrap();
+    let pos: Vec<f64> = tracking.iter().filter_map(|b| b.pos_m.map(|p| p.mean)).collect();
+    100.0 * pos.iter().sum::<f64>() / pos.len() as f64
+}
+
+fn check(take: &str, range: std::ops::Range<usize>) {
+    let Some(gmr) = solve(take, range.clone(), RetargetOptions::gmr()) else { return };
+    let def = solve(take, range, RetargetOptions::default()).unwrap();
+    let (g, d) = (&gmr, &def);
+    eprintln!(
+        "{take}: penetration {:.3}/{:.3}, self-collision frames {}/{}, skate {:.4}/{:.4}, \
+         sole in band {:.3}/{:.3}, speed over {}/{}, jitter {:.2}/{:.2}, pos err {:.2}/{:.2} cm",
+        g.ground_penetration.duration,
+        d.ground_penetration.duration,
+        g.self_collision.frames_deep,
+        d.self_collision.frames_deep,
+        g.skating.as_ref().unwrap().duration,
+        d.skating.as_ref().unwrap().duration,
+        g.stance.as_ref().unwrap().sole_in_band_share,
+        d.stance.as_ref().unwrap().sole_in_band_share,
+        g.joint_speed.as_ref().unwrap().violations,
+        d.joint_speed.as_ref().unwrap().violations,
+        mean_jitter(g),
+        mean_jitter(d),
+        mean_pos_error_cm(g),
+        mean_pos_error_cm(d),
+    );
+    // Nothing through the floor, nothing through itself, within the speed limits.
+    assert_eq!(d.ground_penetration.frames, 0, "{:?}", d.ground_penetration);
+    assert_eq!(d.self_collision.frames_deep, 0, "{:?}", d.self_collision);
+    assert_eq!(d.joint_speed.as_ref().unwrap().violations, 0, "{:?}", d.joint_speed);
+    assert_eq!(d.joint_limits.violations, 0);
+    // Planted feet: the sole on the floor in stance, (almost) no skating.
+    let stance = d.stance.as_ref().unwrap();
+    assert!(stance.sole_in_band_share > 0.98, "{stance:?}");
+    let skating = d.skating.as_ref().unwrap();
+    assert!(skating.duration < 0.01, "{skating:?}");
+    assert!(skating.duration < g.skating.as_ref().unwrap().duration / 5.0);
+    // No extra jitter; tracking as good as GMR's to within 10 %.
+    assert!(mean_jitter(d) <= mean_jitter(g), "{} > {}", mean_jitter(d), mean_jitter(g));
+    assert!(mean_pos_error_cm(d) < 1.1 * mean_pos_error_cm(g));
+}
+
+#[test]
+fn walk_is_planted_collision_free_and_within_the_speed_limits() {
+    check("lafan1_take_via_bvhtools_test.bvh", 0..1800);
+}
+
+#[test]
+fn jumps_are_planted_collision_free_and_within_the_speed_limits() {
+    // The jumps take's first minute: GMR reaches 1.1× the G1's speed limits and 6 cm into the
+    // floor over the whole take.
+    check("lafan1_take_via_bvhtools_test2.bvh", 0..1800);
+}

@@ -1,0 +1,106 @@
+"""GMR's API over ``retarget``: change ``general_motion_retargeting`` to ``retarget.gmr``.
+
+>>> from retarget.gmr import GeneralMotionRetargeting as GMR, load_bvh_file
+>>> frames, height = load_bvh_file("walk.bvh", format="lafan1")          # doctest: +SKIP
+>>> gmr = GMR(src_human="bvh_lafan1", tgt_robot="unitree_g1", actual_human_height=height)  # doctest: +SKIP
+>>> qpos = gmr.retarget(frames[0])                                      # doctest: +SKIP
+
+``GeneralMotionRetargeting.retarget`` is GMR's per-frame solve reproduced exactly (the same
+targets, weights, damping, stopping rule and exact QP; our parity test holds it to 1e-6 rad of
+GMR's own output on the LAFAN1 walk). ``load_bvh_file`` returns what GMR's loader returns.
+
+Differences: only GMR's ``bvh_lafan1`` configs ship (``src_human="bvh_lafan1"``); the solver is
+exact whatever ``solver`` names (GMR: daqp); ``use_velocity_limit`` changes nothing (GMR passes
+its velocity limits into mink's ``safety_break`` argument, so GMR never applies them either);
+nothing is printed (``verbose``); there is no MuJoCo model (``model``, ``configuration``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Mapping, Sequence, Tuple
+
+import numpy as np
+
+from . import _native
+
+__all__ = ["GeneralMotionRetargeting", "load_bvh_file"]
+
+#: GMR's ``src_human`` names we have configs for, by robot: GMR's ``IK_CONFIG_DICT``.
+IK_CONFIG_DICT: Dict[str, Dict[str, str]] = {
+    "bvh_lafan1": {key: f"configs/bvh_lafan1_to_{key}.json" for key in _native.shipped_robots()},
+}
+
+HumanData = Mapping[str, Sequence[Any]]
+
+
+def load_bvh_file(bvh_file: "os.PathLike[str] | str", format: str = "lafan1") -> Tuple[List[Dict[str, List[np.ndarray]]], float]:
+    """GMR's ``general_motion_retargeting.utils.lafan1.load_bvh_file``.
+
+    Returns ``(frames, human_height)``: per frame a dict ``{body: [position, orientation]}``
+    with every joint of the file (End Sites left out) and ``LeftFootMod``/``RightFootMod``
+    (the foot's position with the toe's orientation; the toe is ``LeftToe`` for
+    ``format="lafan1"``, ``LeftToeBase`` for ``"nokov"``). Positions are metres (the file in
+    centimetres) with Z up (the file's Y up turned +90° about X), orientations w x y z.
+    ``human_height`` is GMR's constant 1.75.
+    """
+    return _native.load_bvh_gmr(os.fspath(bvh_file), format)
+
+
+class GeneralMotionRetargeting:
+    """GMR's ``GeneralMotionRetargeting``: ``retarget(human_data)`` solves one frame,
+    warm-started from the previous one, and returns the robot's ``qpos``."""
+
+    def __init__(
+        self,
+        src_human: str,
+        tgt_robot: str,
+        actual_human_height: "float | None" = None,
+        solver: str = "daqp",
+        damping: float = 5e-1,
+        verbose: bool = True,
+        use_velocity_limit: bool = False,
+    ) -> None:
+        if src_human not in IK_CONFIG_DICT:
+            raise KeyError(f"{src_human!r}: configs ship for {sorted(IK_CONFIG_DICT)} only")
+        if tgt_robot not in IK_CONFIG_DICT[src_human]:
+            raise KeyError(f"{tgt_robot!r}: shipped robots are {sorted(IK_CONFIG_DICT[src_human])}")
+        if damping != 5e-1:
+            raise NotImplementedError("damping other than GMR's default 0.5")
+        self.src_human = src_human
+        self.tgt_robot = tgt_robot
+        self.solver = solver
+        self.damping = damping
+        self.verbose = verbose
+        self.max_iter = 10
+        self._retargeter = _native.Retargeter(tgt_robot, mode="gmr", human_height=actual_human_height)
+        ik_config = json.loads(self._retargeter.config_json())
+        ratio = 1.0 if actual_human_height is None else actual_human_height / ik_config["human_height_assumption"]
+        self.ik_match_table1 = ik_config["ik_match_table1"]
+        self.ik_match_table2 = ik_config["ik_match_table2"]
+        self.human_root_name = ik_config["human_root_name"]
+        self.robot_root_name = ik_config["robot_root_name"]
+        self.use_ik_match_table1 = ik_config["use_ik_match_table1"]
+        self.use_ik_match_table2 = ik_config["use_ik_match_table2"]
+        self.human_scale_table = {k: v * ratio for k, v in ik_config["human_scale_table"].items()}
+        self.ground = ik_config["ground_height"] * np.array([0, 0, 1])
+        self.robot_dof_names = {name: 6 + i for i, name in enumerate(self._retargeter.joint_names)}
+        self.robot_body_names = {"world": 0, **{name: i + 1 for i, name in enumerate(self._retargeter.body_names)}}
+        self.scaled_human_data: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        self.ground_offset = 0.0
+
+    def retarget(self, human_data: HumanData, offset_to_ground: bool = False) -> np.ndarray:
+        """Solves one frame ``{body: (position, wxyz quaternion)}`` and returns ``qpos``
+        (root position, root quaternion w x y z, joints in MJCF order)."""
+        if offset_to_ground:
+            raise NotImplementedError("offset_to_ground=True")
+        qpos = self._retargeter.step(human_data)
+        self.scaled_human_data = dict(self._retargeter.last_targets())
+        return qpos
+
+    def set_ground_offset(self, ground_offset: float) -> None:
+        """GMR's ground offset; only 0 (GMR's default) is supported."""
+        if ground_offset != 0.0:
+            raise NotImplementedError("a non-zero ground offset")
+        self.ground_offset = ground_offset

@@ -1,0 +1,624 @@
+//! `retarget._native`: the Python face of [`retarget::Retargeter`]. Everything here converts
+//! between Python objects and the library's types and releases the GIL around the work; the
+//! algorithms live in the library crates (the Python package adds `retarget.gmr`, a thin
+//! layer of GMR's names over these functions).
+
+// No panics on input: a panic would reach Python as `PanicException`, not a `RetargetError`.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
+use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyMapping};
+
+use retarget::writers::npy::{Array, ArrayData};
+use retarget::writers::Format;
+use retarget::{ClipDiagnostics, HumanFrame, RetargetOptions, RobotMotion};
+
+pyo3::create_exception!(
+    _native,
+    RetargetError,
+    PyValueError,
+    "A retargeting error: a bad file, config, robot or option (the message says which)."
+);
+
+/// The library's error as a Python exception: missing files are `FileNotFoundError`, other
+/// file system failures `OSError`, everything else `RetargetError` (a `ValueError`).
+fn to_py(err: retarget::Error) -> PyErr {
+    match io_kind(&err) {
+        Some(std::io::ErrorKind::NotFound) => PyFileNotFoundError::new_err(err.to_string()),
+        Some(_) => PyOSError::new_err(err.to_string()),
+        None => RetargetError::new_err(err.to_string()),
+    }
+}
+
+/// The kind of the file system error behind `err`, if one is: along the source chain, and
+/// inside the BVH reader's error (which keeps its I/O error as a field, not a source).
+fn io_kind(err: &retarget::Error) -> Option<std::io::ErrorKind> {
+    match err {
+        retarget::Error::Bvh(bvh::Error::Io { err, .. }) => return Some(err.kind()),
+        retarget::Error::InFile { source, .. } => return io_kind(source),
+        _ => {}
+    }
+    let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(err);
+    while let Some(e) = cause {
+        if let Some(io) = e.downcast_ref::<std::io::Error>() {
+            return Some(io.kind());
+        }
+        cause = e.source();
+    }
+    None
+}
+
+fn options_for(mode: &str, human_height: Option<f64>) -> PyResult<RetargetOptions> {
+    let mut options = match mode {
+        "default" | "plausible" => RetargetOptions::default(),
+        "gmr" => RetargetOptions::gmr(),
+        "causal" => RetargetOptions::causal(),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "mode {other:?}: expected \"default\", \"gmr\" or \"causal\""
+            )))
+        }
+    };
+    options.human_height = human_height;
+    Ok(options)
+}
+
+fn build(
+    robot: &str,
+    config: Option<PathBuf>,
+    mode: &str,
+    human_height: Option<f64>,
+    fps: f64,
+) -> PyResult<retarget::Retargeter> {
+    let mut inner = retarget::Retargeter::new(robot)
+        .map_err(to_py)?
+        .with_options(options_for(mode, human_height)?)
+        .with_stream_fps(fps);
+    if let Some(path) = config {
+        inner = inner.with_config(retarget::IkConfig::from_file(&path).map_err(to_py)?);
+    }
+    Ok(inner)
+}
+
+/// Retargets human motion onto one robot.
+///
+/// Args:
+///     robot: a shipped robot (``"unitree_g1"``, see ``retarget.shipped_robots()``) or the
+///         path of an MJCF (``.xml``) or URDF (``.urdf``) file.
+///     config: an IK config file (GMR's JSON schema). Default: for a BVH, GMR's tuned config
+///         for LAFAN1-named skeletons on shipped robots, else one derived from the skeleton's
+///         and the robot's roles; for frames, the shipped robot's tuned config.
+///     mode: ``"default"`` (planted feet, ground, self-collision and joint-speed
+///         constraints, a smoothing pass), ``"gmr"`` (GMR's exact solve) or ``"causal"``
+///         (the default's constraints without planting or smoothing: what ``step`` runs).
+///     human_height: subject height in metres. Default: estimated from a BVH skeleton; the
+///         config's ``human_height_assumption`` for frames.
+///     fps: frame rate of streamed frames (``step``), for the joint speed limits.
+#[pyclass(module = "retarget")]
+struct Retargeter {
+    inner: retarget::Retargeter,
+}
+
+#[pymethods]
+impl Retargeter {
+    #[new]
+    #[pyo3(signature = (robot, config=None, *, mode="default", human_height=None, fps=30.0))]
+    fn new(
+        robot: &str,
+        config: Option<PathBuf>,
+        mode: &str,
+        human_height: Option<f64>,
+        fps: f64,
+    ) -> PyResult<Retargeter> {
+        Ok(Retargeter { inner: build(robot, config, mode, human_height, fps)? })
+    }
+
+    /// The robot's name: the shipped key or the model file's stem.
+    #[getter]
+    fn robot(&self) -> String {
+        self.inner.label().to_owned()
+    }
+
+    /// Length of one ``qpos`` (root position, root quaternion w x y z, joints).
+    #[getter]
+    fn nq(&self) -> usize {
+        self.inner.model().nq
+    }
+
+    /// The robot's non-root joints, in ``qpos`` order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        let model = self.inner.model();
+        model
+            .joints
+            .iter()
+            .filter(|j| j.kind != mjcf::JointType::Free)
+            .map(|j| j.name.clone())
+            .collect()
+    }
+
+    /// The robot's bodies (the world left out), in MuJoCo order.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.inner.model().bodies.iter().skip(1).map(|b| b.name.clone()).collect()
+    }
+
+    /// The JSON text of the config that frames and ``retarget_frames`` use.
+    fn config_json(&self) -> PyResult<String> {
+        Ok(self.inner.motion_config().map_err(to_py)?.json().to_owned())
+    }
+
+    /// Retargets a BVH file; returns a ``Motion``.
+    fn retarget_bvh(&self, py: Python<'_>, path: PathBuf) -> PyResult<Motion> {
+        let inner = &self.inner;
+        let (motion, diag) = py.detach(|| inner.retarget_bvh_file(&path)).map_err(to_py)?;
+        Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Retargets a C3D marker file with a marker-driven IK config (``marker_bodies`` and the
+    /// IK tables in one JSON file, e.g. ``configs/c3d_plugingait_to_unitree_g1.json``).
+    fn retarget_c3d(&self, py: Python<'_>, path: PathBuf, config: PathBuf) -> PyResult<Motion> {
+        let inner = &self.inner;
+        let (motion, diag) =
+            py.detach(|| inner.retarget_c3d_file(&path, &config)).map_err(to_py)?;
+        Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Retargets a clip given as frames of ``{body: (position, wxyz quaternion)}`` (GMR's
+    /// ``human_data``, e.g. from ``retarget.gmr.load_bvh_file``) at ``fps``.
+    #[pyo3(signature = (frames, fps=30.0))]
+    fn retarget_frames(
+        &self,
+        py: Python<'_>,
+        frames: &Bound<'_, PyAny>,
+        fps: f64,
+    ) -> PyResult<Motion> {
+        let human = human_motion(frames, fps)?;
+        let inner = &self.inner;
+        let (motion, diag) = py.detach(|| inner.retarget(&human)).map_err(to_py)?;
+        Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Retargets one streamed frame ``{body: (position, wxyz quaternion)}`` (GMR's
+    /// ``human_data``: metres, Z up) and returns the robot's ``qpos`` (a new array).
+    /// Warm-started from the previous frame; runs the causal solve (see ``mode``).
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        frame: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let frame = human_frame(frame)?;
+        let inner = &mut self.inner;
+        let qpos = py.detach(|| inner.step(&frame).map(<[f64]>::to_vec)).map_err(to_py)?;
+        Ok(qpos.into_pyarray(py))
+    }
+
+    /// Forgets the stream: the next ``step`` starts again from the robot's home pose.
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+
+    /// The targets of the last streamed frame, ``{human body: (position, wxyz quaternion)}``
+    /// after scaling and offsets (GMR's ``scaled_human_data``).
+    fn last_targets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let out = PyDict::new(py);
+        for (name, pose) in self.inner.last_step_targets() {
+            let pos = vec![pose.pos.x, pose.pos.y, pose.pos.z].into_pyarray(py);
+            let quat = pose.quat.to_vec().into_pyarray(py);
+            out.set_item(name, (pos, quat))?;
+        }
+        Ok(out)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Retargeter({:?}, nq={})", self.inner.label(), self.inner.model().nq)
+    }
+}
+
+/// ``(position, quaternion)`` of one body: sequences or arrays of 3 and 4 floats.
+fn pose(value: &Bound<'_, PyAny>) -> PyResult<(Vector3<f64>, UnitQuaternion<f64>)> {
+    let p: [f64; 3] = floats(&value.get_item(0)?)?;
+    let q: [f64; 4] = floats(&value.get_item(1)?)?;
+    let quat = Quaternion::new(q[0], q[1], q[2], q[3]);
+    let norm = quat.norm();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(PyValueError::new_err(format!("quaternion {q:?} has no direction")));
+    }
+    // A unit quaternion is taken as it is (bit for bit), anything else normalised.
+    let unit = if (norm - 1.0).abs() <= 4.0 * f64::EPSILON {
+        UnitQuaternion::new_unchecked(quat)
+    } else {
+        UnitQuaternion::new_normalize(quat)
+    };
+    Ok((Vector3::new(p[0], p[1], p[2]), unit))
+}
+
+fn floats<const N: usize>(value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
+    if let Ok(array) = value.extract::<PyReadonlyArray1<'_, f64>>() {
+        if let Ok(slice) = array.as_slice() {
+            if let Ok(out) = <[f64; N]>::try_from(slice) {
+                return Ok(out);
+            }
+        }
+    }
+    value.extract::<[f64; N]>()
+}
+
+/// A ``{body: (position, quaternion)}`` mapping as a frame.
+fn human_frame(frame: &Bound<'_, PyAny>) -> PyResult<HumanFrame> {
+    let mapping = frame.cast::<PyMapping>()?;
+    let items = mapping.items()?;
+    let mut out = HumanFrame::with_capacity(items.len());
+    for item in items.iter() {
+        let (name, value): (String, Bound<'_, PyAny>) = item.extract()?;
+        let (p, q) = pose(&value).map_err(|e| {
+            PyValueError::new_err(format!(
+                "body {name:?}: expected (position, wxyz quaternion): {e}"
+            ))
+        })?;
+        out.push(&name, p, q);
+    }
+    Ok(out)
+}
+
+/// Frames of ``{body: (position, quaternion)}`` as one motion (bodies of the first frame).
+fn human_motion(frames: &Bound<'_, PyAny>, fps: f64) -> PyResult<fk::HumanMotion> {
+    let mut human = fk::HumanMotion {
+        fps,
+        body_names: Vec::new(),
+        num_frames: 0,
+        positions: Vec::new(),
+        orientations: Vec::new(),
+    };
+    for item in frames.try_iter()? {
+        let frame = human_frame(&item?)?;
+        if human.num_frames == 0 {
+            human.body_names.clone_from(&frame.body_names);
+        }
+        for name in &human.body_names {
+            let found = frame
+                .body_names
+                .iter()
+                .position(|n| n == name)
+                .and_then(|i| Some((frame.positions.get(i)?, frame.orientations.get(i)?)));
+            let (position, orientation) = found.ok_or_else(|| {
+                PyValueError::new_err(format!("frame {}: no body {name:?}", human.num_frames))
+            })?;
+            human.positions.push(*position);
+            human.orientations.push(*orientation);
+        }
+        human.num_frames += 1;
+    }
+    Ok(human)
+}
+
+/// A retargeted clip. Its fields are numpy arrays named as in the ``.npz`` it saves
+/// (``qpos``, ``joint_pos``, ``joint_vel``, ``body_pos_w``, ``body_quat_w``,
+/// ``body_lin_vel_w``, ``body_ang_vel_w``, ``target_pos``, ``target_quat``,
+/// ``contact_left``/``contact_right``), plus ``fps``, ``joint_names``, ``body_names``,
+/// ``target_body_names`` and ``robot``. Arrays are computed on first access and handed to
+/// numpy without a copy; they are read-only (copy one to change it).
+#[pyclass(module = "retarget", frozen)]
+struct Motion {
+    motion: RobotMotion,
+    model: Arc<mjcf::Model>,
+    diag: ClipDiagnostics,
+    arrays: OnceLock<Py<PyDict>>,
+}
+
+impl Motion {
+    fn new(motion: RobotMotion, diag: ClipDiagnostics, model: Arc<mjcf::Model>) -> Motion {
+        Motion { motion, model, diag, arrays: OnceLock::new() }
+    }
+
+    /// Every array of the ``.npz``, built once.
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(dict) = self.arrays.get() {
+            return Ok(dict.bind(py).clone());
+        }
+        let (motion, model) = (&self.motion, &self.model);
+        let arrays = py.detach(|| retarget::writers::npz_arrays(motion, model)).map_err(to_py)?;
+        let dict = PyDict::new(py);
+        for (key, array) in arrays {
+            dict.set_item(key, to_numpy(py, array)?)?;
+        }
+        let _ = self.arrays.set(dict.clone().unbind());
+        Ok(dict)
+    }
+
+    fn get<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.arrays(py)?.get_item(key)
+    }
+}
+
+/// An npz array as numpy: float64 and bool arrays moved (no copy) and reshaped (a view),
+/// read-only; strings as a numpy unicode array.
+fn to_numpy(py: Python<'_>, array: Array) -> PyResult<Bound<'_, PyAny>> {
+    let shape = array.shape;
+    let out = match array.data {
+        ArrayData::F64(data) => read_only(data.into_pyarray(py).reshape(shape)?.into_any())?,
+        ArrayData::Bool(data) => read_only(data.into_pyarray(py).reshape(shape)?.into_any())?,
+        ArrayData::Str(items) => {
+            let numpy = py.import("numpy")?;
+            let list = if shape.is_empty() {
+                items.into_iter().next().unwrap_or_default().into_pyobject(py)?.into_any()
+            } else {
+                PyList::new(py, items)?.into_any()
+            };
+            numpy.call_method1("array", (list,))?
+        }
+    };
+    Ok(out)
+}
+
+fn read_only(array: Bound<'_, PyAny>) -> PyResult<Bound<'_, PyAny>> {
+    array.getattr("flags")?.setattr("writeable", false)?;
+    Ok(array)
+}
+
+#[pymethods]
+impl Motion {
+    /// Frames per second.
+    #[getter]
+    fn fps(&self) -> f64 {
+        self.motion.fps
+    }
+
+    /// ``qpos`` per frame (T × nq): root position, root quaternion w x y z, joints.
+    #[getter]
+    fn qpos<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "qpos")
+    }
+
+    /// Joint positions (T × (nq − 7)), BeyondMimic's ``joint_pos``.
+    #[getter]
+    fn joint_pos<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "joint_pos")
+    }
+
+    /// Joint velocities (T × (nq − 7)), numpy ``gradient``'s scheme.
+    #[getter]
+    fn joint_vel<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "joint_vel")
+    }
+
+    /// World body positions (T × B × 3).
+    #[getter]
+    fn body_pos_w<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "body_pos_w")
+    }
+
+    /// World body orientations (T × B × 4, w x y z).
+    #[getter]
+    fn body_quat_w<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "body_quat_w")
+    }
+
+    /// World body linear velocities (T × B × 3).
+    #[getter]
+    fn body_lin_vel_w<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "body_lin_vel_w")
+    }
+
+    /// World body angular velocities (T × B × 3).
+    #[getter]
+    fn body_ang_vel_w<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "body_ang_vel_w")
+    }
+
+    /// The IK target positions the solver tracked (T × K × 3).
+    #[getter]
+    fn target_pos<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "target_pos")
+    }
+
+    /// The IK target orientations (T × K × 4, w x y z).
+    #[getter]
+    fn target_quat<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "target_quat")
+    }
+
+    /// Per frame, whether the source's left foot is on the floor (``None`` when unknown).
+    #[getter]
+    fn contact_left<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "contact_left")
+    }
+
+    /// Per frame, whether the source's right foot is on the floor (``None`` when unknown).
+    #[getter]
+    fn contact_right<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.get(py, "contact_right")
+    }
+
+    /// The robot's non-root joints, in ``qpos`` order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.motion.joint_names.clone()
+    }
+
+    /// The robot's bodies (the world left out), in MuJoCo order.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        self.motion.body_names.clone()
+    }
+
+    /// The bodies with IK targets, in ``target_pos`` order.
+    #[getter]
+    fn target_body_names(&self) -> Vec<String> {
+        self.motion.targets.as_ref().map(|t| t.body_names.clone()).unwrap_or_default()
+    }
+
+    /// The robot model's name (MJCF ``model`` attribute).
+    #[getter]
+    fn robot(&self) -> String {
+        self.model.name.clone()
+    }
+
+    /// Subject height used (m) and where it came from.
+    #[getter]
+    fn human_height(&self) -> (f64, String) {
+        (self.diag.human_height, self.diag.human_height_source.clone())
+    }
+
+    /// What was inferred about the source (up axis, unit, roles) and the config used.
+    #[getter]
+    fn inferred(&self) -> String {
+        self.diag.human_inferred.clone()
+    }
+
+    /// Seconds the IK took.
+    #[getter]
+    fn solve_seconds(&self) -> f64 {
+        self.diag.solve_seconds
+    }
+
+    /// Every array of the ``.npz`` by key, exactly as ``numpy.load`` gives them (``fps`` of
+    /// shape (1,), names as unicode arrays).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.arrays(py)?.copy()
+    }
+
+    /// Writes the motion: ``.npz`` (BeyondMimic's keys), ``.csv`` (Unitree's layout), ``.pkl``
+    /// (GMR's pickle) or ``.json``, by the extension unless ``format`` names one. Atomic.
+    #[pyo3(signature = (path, format=None))]
+    fn save(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<()> {
+        let format = match format {
+            None => None,
+            Some(name) => {
+                Some(Format::from_path(&PathBuf::from(format!("x.{name}"))).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "format {name:?}: expected npz, csv, pkl or json"
+                    ))
+                })?)
+            }
+        };
+        let (motion, model) = (&self.motion, &self.model);
+        py.detach(|| retarget::writers::write_motion(&path, motion, model, format)).map_err(to_py)
+    }
+
+    /// The quality report as JSON text (``retarget.report`` returns it as a dict).
+    fn report_json(&self, py: Python<'_>) -> PyResult<String> {
+        let (motion, model) = (&self.motion, &self.model);
+        let options = retarget::report::ReportOptions::default();
+        let report =
+            py.detach(|| retarget::report::report(motion, model, &options)).map_err(to_py)?;
+        serde_json::to_string(&report).map_err(|e| RetargetError::new_err(e.to_string()))
+    }
+
+    fn __len__(&self) -> usize {
+        self.motion.num_frames()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Motion(robot={:?}, frames={}, fps={}, nq={})",
+            self.model.name,
+            self.motion.num_frames(),
+            self.motion.fps,
+            self.motion.nq
+        )
+    }
+}
+
+/// GMR's ``load_bvh_file``: frames of ``{body: [position, wxyz quaternion]}`` (joints, no End
+/// Sites, then ``LeftFootMod``/``RightFootMod``; metres, Z up) and GMR's height 1.75 m.
+#[pyfunction]
+#[pyo3(signature = (path, format="lafan1"))]
+fn load_bvh_gmr<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    format: &str,
+) -> PyResult<(Bound<'py, PyList>, f64)> {
+    let format = retarget::gmr::BvhFormat::from_name(format)
+        .ok_or_else(|| PyValueError::new_err(format!("Invalid format: {format}")))?;
+    let human = py
+        .detach(|| {
+            let bvh = bvh::from_path(&path)?;
+            retarget::gmr::load_bvh(&bvh, format)
+        })
+        .map_err(|e: retarget::Error| to_py(e))?;
+    let frames = PyList::empty(py);
+    // Frame by frame (`max(1)`: a motion without bodies has no rows to split).
+    let nb = human.num_bodies().max(1);
+    let rows = human.positions.chunks_exact(nb).zip(human.orientations.chunks_exact(nb));
+    for (positions, orientations) in rows {
+        let frame = PyDict::new(py);
+        for ((name, p), q) in human.body_names.iter().zip(positions).zip(orientations) {
+            let pos = PyArray1::from_slice(py, &[p.x, p.y, p.z]);
+            let quat = PyArray1::from_slice(py, &[q.w, q.i, q.j, q.k]);
+            frame.set_item(name, PyList::new(py, [pos.into_any(), quat.into_any()])?)?;
+        }
+        frames.append(frame)?;
+    }
+    Ok((frames, retarget::gmr::HUMAN_HEIGHT))
+}
+
+/// Retargets BVH files into ``out_dir`` (``<stem>.<format>``) on ``jobs`` threads (0: one per
+/// core); returns one dict per file: ``input``, ``output``, and ``frames``, ``seconds``,
+/// ``inferred`` or ``error``.
+#[pyfunction]
+#[pyo3(signature = (paths, robot, out_dir, jobs=0, *, config=None, mode="default", format="npz", human_height=None))]
+#[allow(clippy::too_many_arguments)]
+fn batch<'py>(
+    py: Python<'py>,
+    paths: Vec<PathBuf>,
+    robot: &str,
+    out_dir: PathBuf,
+    jobs: usize,
+    config: Option<PathBuf>,
+    mode: &str,
+    format: &str,
+    human_height: Option<f64>,
+) -> PyResult<Bound<'py, PyList>> {
+    let inner = build(robot, config, mode, human_height, 30.0)?;
+    let pairs: Vec<(PathBuf, PathBuf)> = paths
+        .iter()
+        .map(|p| {
+            let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            (p.clone(), out_dir.join(format!("{stem}.{format}")))
+        })
+        .collect();
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| PyOSError::new_err(format!("{}: {e}", out_dir.display())))?;
+    let results = py.detach(|| inner.retarget_files(&pairs, jobs)).map_err(to_py)?;
+    let out = PyList::empty(py);
+    for ((input, output), result) in pairs.iter().zip(results) {
+        let row = PyDict::new(py);
+        row.set_item("input", input.display().to_string())?;
+        row.set_item("output", output.display().to_string())?;
+        match result {
+            Ok(r) => {
+                row.set_item("frames", r.frames)?;
+                row.set_item("seconds", r.seconds)?;
+                row.set_item("inferred", r.inferred)?;
+            }
+            Err(e) => row.set_item("error", e.to_string())?,
+        }
+        out.append(row)?;
+    }
+    Ok(out)
+}
+
+/// The shipped robots' keys.
+#[pyfunction]
+fn shipped_robots() -> Vec<&'static str> {
+    retarget::shipped::keys().collect()
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Retargeter>()?;
+    m.add_class::<Motion>()?;
+    m.add("RetargetError", m.py().get_type::<RetargetError>())?;
+    m.add_function(wrap_pyfunction!(load_bvh_gmr, m)?)?;
+    m.add_function(wrap_pyfunction!(batch, m)?)?;
+    m.add_function(wrap_pyfunction!(shipped_robots, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
