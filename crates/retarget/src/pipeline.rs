@@ -383,7 +383,7 @@ impl<'a> Prepared<'a> {
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt)?);
-            if solver.qpos().iter().any(|v| !v.is_finite()) {
+            if diverged(solver.qpos()) {
                 return Err(Error::NonFinite {
                     frame: f,
                     message: "the solver diverged".to_owned(),
@@ -399,6 +399,12 @@ impl<'a> Prepared<'a> {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
+                    if diverged(solver.qpos()) {
+                        return Err(Error::NonFinite {
+                            frame: f,
+                            message: "the solver diverged".to_owned(),
+                        });
+                    }
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
                     let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
@@ -683,6 +689,29 @@ pub fn task_specs(config: &IkConfig, model: &Model, map: &TargetMap) -> Vec<Vec<
         .collect()
 }
 
+/// A configuration no solve of a real motion reaches: a coordinate not finite, or beyond
+/// [`fk::MAX_DISTANCE`] (100 km for the root, as many radians for a joint). Written output
+/// must never hold one (a near-singular step once put a root at 6.7e10 m).
+pub(crate) fn diverged(qpos: &[f64]) -> bool {
+    qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
+}
+
 pub(crate) fn finite_pose(p: &Pose) -> bool {
     p.pos.iter().all(|v| v.is_finite()) && p.quat.iter().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::diverged;
+
+    #[test]
+    fn absurd_configurations_are_divergence() {
+        let mut q = vec![0.0, 0.0, 0.8, 1.0, 0.0, 0.0, 0.0, 0.3, -2.0];
+        assert!(!diverged(&q));
+        q[0] = 6.7e10; // the root of a blown-up step
+        assert!(diverged(&q));
+        q[0] = 0.0;
+        q[8] = f64::NAN;
+        assert!(diverged(&q));
+    }
 }

@@ -594,7 +594,7 @@ impl Stream {
                 }
             }
             let diag = solver.solve_frame(targets, dt)?;
-            if solver.qpos().iter().any(|v| !v.is_finite()) {
+            if crate::pipeline::diverged(solver.qpos()) {
                 return Err(Error::NonFinite {
                     frame: index,
                     message: "the solver diverged".to_owned(),
