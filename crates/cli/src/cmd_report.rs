@@ -26,7 +26,8 @@ pub struct ReportArgs {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<PathBuf>,
-    /// Foot bodies, left then right (default: the ankle/foot bodies found by name).
+    /// Foot bodies, left then right (default: the ankle/foot bodies found by name, else the
+    /// robot recogniser's feet).
     #[arg(long, num_args = 2, value_names = ["LEFT", "RIGHT"])]
     pub feet: Option<Vec<String>>,
     /// Height of the ground plane (m).

@@ -553,7 +553,8 @@ fn named_body(model: &mjcf::Model, name: &str) -> Result<usize, Error> {
         .ok_or_else(|| Error::Options(format!("no body named \"{name}\" in the robot model")))
 }
 
-/// The two foot bodies `[left, right]` (see [`ReportOptions::feet`]).
+/// The two foot bodies `[left, right]` (see [`ReportOptions::feet`]): by name, else the
+/// robot recogniser's ([`crate::RobotRoles`]) feet.
 pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
     if let (Some(l), Some(r)) =
         (model.body_id("left_ankle_roll_link"), model.body_id("right_ankle_roll_link"))
@@ -582,9 +583,14 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
     };
     match (side(["left", "_l_", "_l"], "l_"), side(["right", "_r_", "_r"], "r_")) {
         (Some(l), Some(r)) if l != r => Ok([l, r]),
-        _ => Err(Error::Options(
-            "cannot find the two foot bodies by name (ankle/foot, left/right): name them".into(),
-        )),
+        // Names say nothing: the robot recogniser's feet (tree and geometry).
+        _ => match crate::robot_roles::RobotRoles::recognise(model) {
+            Ok(roles) => Ok(roles.soles.map(|s| s.body)),
+            Err(e) => Err(Error::Options(format!(
+                "cannot find the two foot bodies by name (ankle/foot, left/right) nor by \
+                 recognising the robot ({e}): name them"
+            ))),
+        },
     }
 }
 

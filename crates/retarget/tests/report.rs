@@ -288,6 +288,23 @@ fn unknown_foot_names_are_errors() {
     assert!(err.contains("left_foot"), "{err}");
 }
 
+/// A robot whose names say nothing (`link1`…) gets the recogniser's feet: the report works
+/// and the default solve plants them (both use `detect_feet`).
+#[test]
+fn feet_of_a_robot_with_numbered_names_come_from_the_recogniser() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/robots/numbered.xml");
+    let model = mjcf::Model::from_file(&path).unwrap();
+    let roles = retarget::RobotRoles::recognise(&model).unwrap();
+    let feet = detect_feet(&model).unwrap();
+    assert_eq!(feet, roles.soles.map(|s| s.body));
+    let mut data = mjcf::Data::new(&model);
+    model.kinematics(&model.qpos0, &mut data);
+    let [l, r] = feet;
+    let left = Vector3::z().cross(&roles.forward);
+    assert!((data.xpos[l] - data.xpos[r]).dot(&left) > 0.0, "the left foot is on the left");
+}
+
 /// Every shipped robot has two feet found automatically, the left one on the robot's left
 /// (+y in the MJCF frame at qpos0, where every model faces +x).
 #[test]
