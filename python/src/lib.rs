@@ -134,19 +134,13 @@ impl Retargeter {
     /// The robot's non-root joints, in ``qpos`` order.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
-        let model = self.inner.model();
-        model
-            .joints
-            .iter()
-            .filter(|j| j.kind != mjcf::JointType::Free)
-            .map(|j| j.name.clone())
-            .collect()
+        retarget::RobotMotion::model_joint_names(self.inner.model())
     }
 
     /// The robot's bodies (the world left out), in MuJoCo order.
     #[getter]
     fn body_names(&self) -> Vec<String> {
-        self.inner.model().bodies.iter().skip(1).map(|b| b.name.clone()).collect()
+        retarget::RobotMotion::model_body_names(self.inner.model())
     }
 
     /// The JSON text of the config that frames and ``retarget_frames`` use.

@@ -999,13 +999,8 @@ impl NpzTarget {
             out.extend_from_slice(&data);
             (format!("{key}.npy"), out, false)
         };
-        let joints: Vec<String> = model
-            .joints
-            .iter()
-            .filter(|j| j.kind != mjcf::JointType::Free)
-            .map(|j| j.name.clone())
-            .collect();
-        let bodies: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+        let joints = retarget::RobotMotion::model_joint_names(model);
+        let bodies = retarget::RobotMotion::model_body_names(model);
         let nq = model.nq;
         let mut members = vec![
             member("fps", "<f8".to_owned(), "(1,)", floats(u, 1, &[30.0])?),
@@ -1076,13 +1071,8 @@ impl NpzTarget {
             fps: 30.0,
             nq: model.nq,
             qpos,
-            joint_names: model
-                .joints
-                .iter()
-                .filter(|j| j.kind != mjcf::JointType::Free)
-                .map(|j| j.name.clone())
-                .collect(),
-            body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
+            joint_names: retarget::RobotMotion::model_joint_names(model),
+            body_names: retarget::RobotMotion::model_body_names(model),
             targets: None,
             contacts: Some(retarget::FootContacts {
                 left: (0..frames).map(|f| f % 2 == 0).collect(),

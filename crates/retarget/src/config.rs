@@ -204,7 +204,7 @@ impl IkConfig {
     /// no human body driving two active frames of one table). Unknown names are errors with
     /// their position in the file and the nearest existing names.
     pub fn validate(&self, model: &mjcf::Model, human_bodies: &[String]) -> Result<(), Error> {
-        let robot: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+        let robot = crate::RobotMotion::model_body_names(model);
         let human_known = |name: &str| human_bodies.iter().any(|h| h == name);
         if !human_known(&self.human_root_name) {
             return Err(self.unknown("human", &self.human_root_name, human_bodies));

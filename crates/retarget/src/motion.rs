@@ -43,6 +43,25 @@ pub struct RobotMotion {
 }
 
 impl RobotMotion {
+    /// The joint names a motion of `model` carries: every joint but the free root, in model
+    /// order ([`RobotMotion::joint_names`]).
+    #[must_use]
+    pub fn model_joint_names(model: &mjcf::Model) -> Vec<String> {
+        model
+            .joints
+            .iter()
+            .filter(|j| j.kind != mjcf::JointType::Free)
+            .map(|j| j.name.clone())
+            .collect()
+    }
+
+    /// The body names a motion of `model` carries: every body but the world, in model order
+    /// ([`RobotMotion::body_names`]).
+    #[must_use]
+    pub fn model_body_names(model: &mjcf::Model) -> Vec<String> {
+        model.bodies.iter().skip(1).map(|b| b.name.clone()).collect()
+    }
+
     #[must_use]
     pub fn num_frames(&self) -> usize {
         self.qpos.len().checked_div(self.nq).unwrap_or(0)

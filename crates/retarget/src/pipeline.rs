@@ -383,12 +383,7 @@ impl<'a> Prepared<'a> {
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
             frames.push(solver.solve_frame(self.frame_targets(f), dt)?);
-            if diverged(solver.qpos()) {
-                return Err(Error::NonFinite {
-                    frame: f,
-                    message: "the solver diverged".to_owned(),
-                });
-            }
+            reject_divergence(solver.qpos(), f)?;
             qpos.extend_from_slice(solver.qpos());
         }
         if let SolveMode::Plausible(p) = &self.options.mode {
@@ -399,12 +394,7 @@ impl<'a> Prepared<'a> {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
-                    if diverged(solver.qpos()) {
-                        return Err(Error::NonFinite {
-                            frame: f,
-                            message: "the solver diverged".to_owned(),
-                        });
-                    }
+                    reject_divergence(solver.qpos(), f)?;
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
                     let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
@@ -472,13 +462,8 @@ impl<'a> Prepared<'a> {
             fps: self.fps,
             nq: model.nq,
             qpos,
-            joint_names: model
-                .joints
-                .iter()
-                .filter(|j| j.kind != mjcf::JointType::Free)
-                .map(|j| j.name.clone())
-                .collect(),
-            body_names: model.bodies.iter().skip(1).map(|b| b.name.clone()).collect(),
+            joint_names: RobotMotion::model_joint_names(model),
+            body_names: RobotMotion::model_body_names(model),
             targets: Some(TrackedTargets {
                 body_names: tracked_names.clone(),
                 pos: target_pos,
@@ -637,30 +622,27 @@ fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2]
         }
         body = model.bodies[body].parent;
     };
-    // A tracked body welded to the sole (no joint between them: e.g. Toddy's `left_toe_link`
-    // under its sole body `ank_roll_link`) moves rigidly with it and is its foot; otherwise
-    // the nearest tracked ancestor. Walking up from such a sole would plant the shin.
+    // The sole's own task, else a tracked body welded to the sole (no joint between them:
+    // Toddy's `left_toe_link` under its sole body `ank_roll_link`), which moves rigidly with
+    // it; otherwise the nearest tracked ancestor. Walking up from such a sole would plant the
+    // shin.
     let tracked_welded = |sole: usize| {
-        let welded = |b: usize| {
-            let mut b = b;
-            while b != sole {
-                if model.bodies[b].jnt_num > 0 || b == 0 {
-                    return false;
-                }
-                b = model.bodies[b].parent;
+        let welded = |mut b: usize| loop {
+            if b == sole {
+                return true;
             }
-            true
+            if b == 0 || model.bodies[b].jnt_num > 0 {
+                return false;
+            }
+            b = model.bodies[b].parent;
         };
-        stages
-            .iter()
-            .flatten()
-            .find(|t| t.body != sole && welded(t.body))
-            .map(|t| (t.body, t.target))
+        // `min_by_key` keeps the first of equals: the sole if tracked, else the first task's.
+        let task =
+            stages.iter().flatten().filter(|t| welded(t.body)).min_by_key(|t| t.body != sole);
+        task.map(|t| (t.body, t.target))
     };
     soles.map(|sole| {
-        let tracked = stages.iter().flatten().find(|t| t.body == sole).map(|t| (sole, t.target));
-        let (body, slot) =
-            tracked.or_else(|| tracked_welded(sole)).or_else(|| tracked_ancestor(sole))?;
+        let (body, slot) = tracked_welded(sole).or_else(|| tracked_ancestor(sole))?;
         let shin = tracked_ancestor(model.bodies[body].parent);
         RobotFoot::new(model, body, sole, slot, shin)
     })
@@ -692,8 +674,16 @@ pub fn task_specs(config: &IkConfig, model: &Model, map: &TargetMap) -> Vec<Vec<
 /// A configuration no solve of a real motion reaches: a coordinate not finite, or beyond
 /// [`fk::MAX_DISTANCE`] (100 km for the root, as many radians for a joint). Written output
 /// must never hold one (a near-singular step once put a root at 6.7e10 m).
-pub(crate) fn diverged(qpos: &[f64]) -> bool {
+fn diverged(qpos: &[f64]) -> bool {
     qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
+}
+
+/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
+pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
+    if diverged(qpos) {
+        return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });
+    }
+    Ok(())
 }
 
 pub(crate) fn finite_pose(p: &Pose) -> bool {

@@ -594,13 +594,8 @@ impl Stream {
                 }
             }
             let diag = solver.solve_frame(targets, dt)?;
-            if crate::pipeline::diverged(solver.qpos()) {
-                return Err(Error::NonFinite {
-                    frame: index,
-                    message: "the solver diverged".to_owned(),
-                });
-            }
-            Ok(diag)
+            crate::pipeline::reject_divergence(solver.qpos(), index)?;
+            Ok::<_, Error>(diag)
         })?;
         self.last = Some(diag);
         self.frames += 1;

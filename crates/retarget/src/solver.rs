@@ -411,7 +411,6 @@ impl<'m> Solver<'m> {
 
     /// One QP step at the current configuration (errors from `stage_error`).
     fn step(&mut self, s: usize, targets: &[Pose], dt: f64) {
-        let nv = self.model.nv;
         self.qp.h.fill(0.0);
         self.qp.c.fill(0.0);
         let mut mu_total = 0.0;
@@ -419,12 +418,7 @@ impl<'m> Solver<'m> {
             mu_total += self.task_objective(s, k, targets);
         }
         self.add_point_tasks();
-        for d in 0..nv {
-            self.qp.h[d * nv + d] += self.options.damping + mu_total;
-            for e in 0..d {
-                self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
-            }
-        }
+        self.finish_hessian(self.options.damping + mu_total);
         self.set_bounds(dt);
         let status = if self.constraints.is_empty() || !self.constraints_on {
             let status = self.qp.solve();
@@ -439,6 +433,22 @@ impl<'m> Solver<'m> {
                 return; // no finite step: keep the configuration
             }
         }
+        self.take_step();
+    }
+
+    /// Adds `diagonal` to H's diagonal and mirrors its upper triangle into the lower one.
+    fn finish_hessian(&mut self, diagonal: f64) {
+        let nv = self.model.nv;
+        for d in 0..nv {
+            self.qp.h[d * nv + d] += diagonal;
+            for e in 0..d {
+                self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
+            }
+        }
+    }
+
+    /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics.
+    fn take_step(&mut self) {
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
         self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
         self.model.kinematics(&self.qpos, &mut self.data);
@@ -648,28 +658,20 @@ impl<'m> Solver<'m> {
         self.qpos.copy_from_slice(reference);
         self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
-        let nv = self.model.nv;
         for _ in 0..steps {
             self.qp.h.fill(0.0);
             self.qp.c.fill(0.0);
 
             self.add_posture(reference, weight);
             self.add_point_tasks();
-            for d in 0..nv {
-                self.qp.h[d * nv + d] += self.options.damping;
-                for e in 0..d {
-                    self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
-                }
-            }
+            self.finish_hessian(self.options.damping);
             self.set_bounds(dt);
             let status = self.constrained_step();
             if !matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
                 self.qp_failures += 1;
                 break;
             }
-            self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
-            self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
-            self.model.kinematics(&self.qpos, &mut self.data);
+            self.take_step();
         }
         self.previous.copy_from_slice(&self.qpos);
         Ok(())

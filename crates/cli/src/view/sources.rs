@@ -79,7 +79,7 @@ pub fn robot_figure(model: &mjcf::Model, qpos: &[f64], label: &str) -> anyhow::R
             quat: wxyz!(g.quat),
         })
     });
-    let names: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+    let names = retarget::RobotMotion::model_body_names(model);
     let mut data = mjcf::Data::new(model);
     let mut check = Vec::new();
     for frame in [0, frames / 2, frames.saturating_sub(1)] {
@@ -163,14 +163,10 @@ pub fn check_motion_fits(
         model.nq
     );
     if !motion.joint_names.is_empty() {
-        let model_joints: Vec<&str> = model
-            .joints
-            .iter()
-            .filter(|j| j.kind != mjcf::JointType::Free)
-            .map(|j| j.name.as_str())
-            .collect();
-        let motion_joints: Vec<&str> = motion.joint_names.iter().map(String::as_str).collect();
-        ensure!(model_joints == motion_joints, "the motion's joints differ from the robot model's");
+        ensure!(
+            motion.joint_names == retarget::RobotMotion::model_joint_names(model),
+            "the motion's joints differ from the robot model's"
+        );
     }
     Ok(())
 }
@@ -261,7 +257,7 @@ mod tests {
     #[test]
     fn robot_feet_from_the_recogniser() {
         let model = crate::shipped::robot_model("stanford_toddy").unwrap();
-        let names: Vec<String> = model.bodies.iter().skip(1).map(|b| b.name.clone()).collect();
+        let names = retarget::RobotMotion::model_body_names(&model);
         let feet = robot_feet(&model, &names);
         let named: Vec<(&str, &str)> =
             feet.iter().map(|(side, i)| (side.as_str(), names[*i].as_str())).collect();
