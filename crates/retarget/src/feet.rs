@@ -59,6 +59,10 @@ pub struct FootPlanOptions {
     /// Weight of the contact-point task that holds the sole's contact point on its anchor
     /// in stance (the foot tasks' position weights are 50 in GMR's configs).
     pub contact_weight: f64,
+    /// Least horizontal gap (m) between the two soles when both are planted at once: anchors
+    /// closer than this are moved apart ([`separate`]), so that the planted feet do not ask
+    /// for the soles inside each other, which the self-collision constraint then fights.
+    pub sole_gap: f64,
 }
 
 impl Default for FootPlanOptions {
@@ -70,6 +74,7 @@ impl Default for FootPlanOptions {
             stance_weight: 2.0,
             clearance: 0.002,
             contact_weight: 400.0,
+            sole_gap: 0.02,
         }
     }
 }
@@ -299,6 +304,9 @@ pub fn plan(
     let lead = (options.lead_s * fps).round().max(0.0) as usize;
     let mut weight = vec![[1.0; 2]; frames];
     let mut contact = vec![[Vec::new(), Vec::new()]; frames];
+    // Each foot's stance phases and their anchors, (range, xy, yaw), then kept apart.
+    let mut anchors: [Vec<Planted>; 2] = [Vec::new(), Vec::new()];
+    let mut free_targets: [Vec<Pose>; 2] = [Vec::new(), Vec::new()];
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
         let label = &labels[side][..frames.min(labels[side].len())];
@@ -323,10 +331,25 @@ pub fn plan(
         for q in shin.iter_mut().flatten() {
             *q = turn * *q;
         }
+        anchors[side] = phase_list
+            .into_iter()
+            .map(|r| {
+                let (xy, yaw) = anchor(foot, &free, &shin, r.clone(), options.anchor);
+                (r, xy, yaw)
+            })
+            .collect();
+        free_targets[side] = free;
+    }
+    if let [Some(left), Some(right)] = feet {
+        separate(left, right, &mut anchors, options.sole_gap);
+    }
+    for (side, foot) in feet.iter().enumerate() {
+        let Some(foot) = foot else { continue };
+        let free = &free_targets[side];
         let mut ramp = vec![Ramp::default(); frames];
         let mut planted = vec![false; frames];
-        for r in &phase_list {
-            let (xy, yaw) = anchor(foot, &free, &shin, r.clone(), options.anchor);
+        for (r, xy, yaw) in &anchors[side] {
+            let (xy, yaw) = (*xy, *yaw);
             for t in r.clone() {
                 let pose = planted_pose(foot, &free[t], xy, yaw, options.clearance);
                 contact[t][side] = foot.contact_points(&pose, 1.0);
@@ -360,6 +383,50 @@ pub fn plan(
         }
     }
     FootPlan { shift, weight, contact }
+}
+
+/// A stance phase (frames) with its anchor: the flat foot's horizontal position and yaw.
+type Planted = (Range<usize>, Vector3<f64>, f64);
+
+/// Moves the anchors of stance phases that overlap in time apart until the flat soles'
+/// footprints (their bottom corners at the anchors) are at least `gap` apart along the line
+/// through their centres: each moves half the shortfall, along that line. Separation along
+/// one line bounds the true gap from below, so the result is conservative. A phase that
+/// overlaps several of the other foot's is moved for each (three sweeps settle chains).
+/// Soles without boxes have no footprint and are left alone.
+fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2], gap: f64) {
+    if left.corners.is_empty() || right.corners.is_empty() || gap.is_nan() {
+        return;
+    }
+    let footprint = |foot: &RobotFoot, xy: &Vector3<f64>, yaw: f64| -> Vec<Vector3<f64>> {
+        let flat = foot.flat(yaw);
+        foot.corners.iter().map(|c| Vector3::new(xy.x, xy.y, 0.0) + flat * c).collect()
+    };
+    let [lefts, rights] = anchors;
+    for _ in 0..3 {
+        for (lr, lxy, lyaw) in lefts.iter_mut() {
+            for (rr, rxy, ryaw) in rights.iter_mut() {
+                if lr.end <= rr.start || rr.end <= lr.start {
+                    continue;
+                }
+                let (a, b) = (footprint(left, lxy, *lyaw), footprint(right, rxy, *ryaw));
+                let centre = |p: &[Vector3<f64>]| p.iter().sum::<Vector3<f64>>() / p.len() as f64;
+                let mut d = centre(&b) - centre(&a);
+                d.z = 0.0;
+                if d.norm() < 1e-9 {
+                    continue;
+                }
+                d = d.normalize();
+                let reach = a.iter().map(|p| p.dot(&d)).fold(f64::NEG_INFINITY, f64::max);
+                let start = b.iter().map(|p| p.dot(&d)).fold(f64::INFINITY, f64::min);
+                let short = gap - (start - reach);
+                if short > 0.0 {
+                    *lxy -= d * (short / 2.0);
+                    *rxy += d * (short / 2.0);
+                }
+            }
+        }
+    }
 }
 
 /// An offset of a foot target (position and yaw), accumulated with weights.
@@ -488,6 +555,46 @@ fn quat(p: &Pose) -> UnitQuaternion<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A flat foot with a 20 × 10 cm box sole, its origin at the sole's centre, facing +x.
+    fn box_foot() -> RobotFoot {
+        let corners = [(-0.1, -0.05), (-0.1, 0.05), (0.1, -0.05), (0.1, 0.05)]
+            .map(|(x, y)| Vector3::new(x, y, -0.02))
+            .to_vec();
+        RobotFoot {
+            body: 1,
+            slot: 0,
+            sole: Vec::new(),
+            forward: Vector3::x(),
+            rest: UnitQuaternion::identity(),
+            corners,
+            shin: None,
+        }
+    }
+
+    #[test]
+    fn planted_soles_are_kept_apart() {
+        let foot = box_foot();
+        // Both planted over frames 5..15, side by side 6 cm apart: the soles overlap by 4 cm.
+        // A third, later left phase does not overlap any right one and stays.
+        let mut anchors = [
+            vec![
+                (0..10, Vector3::new(0.0, 0.03, 0.0), 0.0),
+                (20..30, Vector3::new(1.0, 0.0, 0.0), 0.0),
+            ],
+            vec![(5..15, Vector3::new(0.0, -0.03, 0.0), 0.0)],
+        ];
+        separate(&foot, &foot, &mut anchors, 0.02);
+        let (left, right) = (anchors[0][0].1, anchors[1][0].1);
+        // Centres 6 cm apart, footprints 10 cm wide: 6 cm short of a 2 cm gap, 3 cm each.
+        assert!((left.y - 0.06).abs() < 1e-12, "{left}");
+        assert!((right.y + 0.06).abs() < 1e-12, "{right}");
+        assert_eq!(anchors[0][1].1, Vector3::new(1.0, 0.0, 0.0));
+        // Already apart: nothing moves.
+        let before = anchors.clone();
+        separate(&foot, &foot, &mut anchors, 0.02);
+        assert_eq!(anchors, before);
+    }
 
     #[test]
     fn smoothstep_ends_flat() {
