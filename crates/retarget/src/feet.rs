@@ -74,7 +74,7 @@ impl Default for FootPlanOptions {
             stance_weight: 2.0,
             clearance: 0.002,
             contact_weight: 400.0,
-            sole_gap: 0.02,
+            sole_gap: 0.03,
         }
     }
 }
@@ -389,9 +389,11 @@ pub fn plan(
 type Planted = (Range<usize>, Vector3<f64>, f64);
 
 /// Moves the anchors of stance phases that overlap in time apart until the flat soles'
-/// footprints (their bottom corners at the anchors) are at least `gap` apart along the line
-/// through their centres: each moves half the shortfall, along that line. Separation along
-/// one line bounds the true gap from below, so the result is conservative. A phase that
+/// footprints (their bottom corners at the anchors) are at least `gap` apart along one of the
+/// footprints' edge directions (the separating axis along which they are furthest apart, so
+/// the shortest way apart: sideways for feet side by side, forwards for one behind the
+/// other): each moves half the shortfall, along that axis. Separation along an axis bounds
+/// the true gap from below, so the result is conservative. A phase that
 /// overlaps several of the other foot's is moved for each (three sweeps settle chains).
 /// Soles without boxes have no footprint and are left alone.
 fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2], gap: f64) {
@@ -410,16 +412,31 @@ fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2]
                     continue;
                 }
                 let (a, b) = (footprint(left, lxy, *lyaw), footprint(right, rxy, *ryaw));
+                // Separating-axis test over both footprints' edge directions: the axis with
+                // the largest separation is the shortest way apart.
+                let axes = [*lyaw, *ryaw].map(|yaw| {
+                    let (s, c) = yaw.sin_cos();
+                    [Vector3::new(c, s, 0.0), Vector3::new(-s, c, 0.0)]
+                });
                 let centre = |p: &[Vector3<f64>]| p.iter().sum::<Vector3<f64>>() / p.len() as f64;
-                let mut d = centre(&b) - centre(&a);
-                d.z = 0.0;
-                if d.norm() < 1e-9 {
-                    continue;
-                }
-                d = d.normalize();
-                let reach = a.iter().map(|p| p.dot(&d)).fold(f64::NEG_INFINITY, f64::max);
-                let start = b.iter().map(|p| p.dot(&d)).fold(f64::INFINITY, f64::min);
-                let short = gap - (start - reach);
+                let apart = centre(&b) - centre(&a);
+                let (d, separation) = axes
+                    .iter()
+                    .flatten()
+                    .map(|u| {
+                        let d = if apart.dot(u) < 0.0 { -u } else { *u };
+                        let reach = a.iter().map(|p| p.dot(&d)).fold(f64::NEG_INFINITY, f64::max);
+                        let start = b.iter().map(|p| p.dot(&d)).fold(f64::INFINITY, f64::min);
+                        (d, start - reach)
+                    })
+                    .fold((Vector3::zeros(), f64::NEG_INFINITY), |best, x| {
+                        if x.1 > best.1 {
+                            x
+                        } else {
+                            best
+                        }
+                    });
+                let short = gap - separation;
                 if short > 0.0 {
                     *lxy -= d * (short / 2.0);
                     *rxy += d * (short / 2.0);
