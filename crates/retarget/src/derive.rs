@@ -989,21 +989,6 @@ pub fn is_role_named(config: &IkConfig) -> bool {
     any
 }
 
-/// The largest angle (rad) between the rotation offsets `a` and `b` give the same robot body,
-/// over the bodies both track: how far apart two configs' ideas of the joint frames are.
-#[must_use]
-pub fn largest_offset_difference(a: &IkConfig, b: &IkConfig) -> Option<f64> {
-    let mut worst: Option<f64> = None;
-    for e in a.ik_match_table1.iter().filter(|e| e.is_active()) {
-        let Some(o) = b.ik_match_table1.iter().find(|o| o.robot_body == e.robot_body) else {
-            continue;
-        };
-        let angle = e.rot_offset.angle_to(&o.rot_offset);
-        worst = Some(worst.map_or(angle, |w: f64| w.max(angle)));
-    }
-    worst
-}
-
 /// The weights of `part` ([`WEIGHTS`]). A robot without a chest role (its arms hang from the
 /// pelvis body: no waist) tracks its pelvis with the larger of the pelvis's and the chest's
 /// weights: that body is its chest too, and with the pelvis's rotation weight (10) against
@@ -1144,9 +1129,93 @@ pub struct Chosen {
     pub summary: String,
 }
 
-/// Largest rotation-offset difference (rad) between a tuned config and the derived one for
-/// which the skeleton counts as the one the tuned config was written for.
-pub const TUNED_AGREES: f64 = 45.0 * std::f64::consts::PI / 180.0;
+/// The joint frames a tuned config was written for, as a skeleton's zero pose shows them:
+/// there every joint's frame is the file's axes, so the direction each bone points in (file
+/// axes) says where the joint frames sit on the body. Two skeletons with the same names,
+/// the same bone directions and the same up axis give the same joint rotations for the same
+/// posture, so a config's rotation offsets written for one hold for the other.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointFrames {
+    /// Whose frames these are, for messages.
+    pub name: &'static str,
+    /// Direction of every trunk and limb bone in the zero pose (file axes): pelvis → chest
+    /// → head, hip → knee → ankle → toe, shoulder → elbow → wrist.
+    pub bone: [f64; 3],
+    /// Direction from the right hip to the left one in the zero pose (file axes).
+    pub left: [f64; 3],
+    /// The file axis that points up in the motion (GMR converts it with its Y-up turn).
+    pub up: fk::UpAxis,
+}
+
+/// LAFAN1's joint frames (Ubisoft La Forge's skeleton), which GMR's `bvh_lafan1_to_*`
+/// configs, the tuned configs shipped, are written for: Y up; in the zero pose the skeleton
+/// lies along +X (every bone along its parent joint's +X), its left hip at +Z.
+pub const LAFAN1_FRAMES: JointFrames = JointFrames {
+    name: "LAFAN1",
+    bone: [1.0, 0.0, 0.0],
+    left: [0.0, 0.0, 1.0],
+    up: fk::UpAxis::PosY,
+};
+
+/// Largest angle between a zero-pose bone (or the hips) and the reference direction for
+/// which the joint frames count as the reference's: LAFAN1's own bones are within 5° of
+/// +X, a skeleton in another zero pose (standing in a T-pose, A-pose, arms down) has bones
+/// 90° off.
+pub const FRAMES_AGREE: f64 = 30.0 * std::f64::consts::PI / 180.0;
+
+/// The bones [`JointFrames::differs`] compares, as (from, to) roles; a pair with a role the
+/// skeleton lacks is skipped (the trunk then runs from the pelvis to the head).
+const FRAME_BONES: [(Role, Role); 13] = [
+    (Role::Pelvis, Role::Chest),
+    (Role::Chest, Role::Head),
+    (Role::LeftThigh, Role::LeftShin),
+    (Role::LeftShin, Role::LeftFoot),
+    (Role::LeftFoot, Role::LeftToe),
+    (Role::RightThigh, Role::RightShin),
+    (Role::RightShin, Role::RightFoot),
+    (Role::RightFoot, Role::RightToe),
+    (Role::LeftUpperArm, Role::LeftForearm),
+    (Role::LeftForearm, Role::LeftHand),
+    (Role::RightUpperArm, Role::RightForearm),
+    (Role::RightForearm, Role::RightHand),
+    (Role::Pelvis, Role::Head),
+];
+
+impl JointFrames {
+    /// `None` when `humanoid`, read with the axis convention `axes`, has these joint frames:
+    /// every bone of its zero pose ([`fk::Humanoid::rest_points`]) and its hips within
+    /// [`FRAMES_AGREE`] of these directions, and the file turned to Z up as these frames'
+    /// up axis is. Otherwise what differs.
+    #[must_use]
+    pub fn differs(&self, humanoid: &Humanoid, axes: fk::AxisConvention) -> Option<String> {
+        let axes = match axes {
+            fk::AxisConvention::Auto => humanoid.up.convention(),
+            given => given,
+        };
+        if axes != self.up.convention() {
+            return Some(format!("it is not turned to Z up from {}'s {} up", self.name, self.up));
+        }
+        let at = |r: &Role| humanoid.rest_points.get(r);
+        let chest = humanoid.rest_points.contains_key(&Role::Chest);
+        let mut checks: Vec<(String, Vector3<f64>, Vector3<f64>)> = FRAME_BONES
+            .iter()
+            .filter(|(from, to)| !(chest && *from == Role::Pelvis && *to == Role::Head))
+            .filter_map(|(from, to)| {
+                let bone = at(to)? - at(from)?;
+                Some((format!("{from} → {to}"), bone, Vector3::from(self.bone)))
+            })
+            .collect();
+        if let (Some(l), Some(r)) = (at(&Role::LeftThigh), at(&Role::RightThigh)) {
+            checks.push(("right → left hip".to_owned(), l - r, Vector3::from(self.left)));
+        }
+        checks.into_iter().find_map(|(what, bone, expected)| {
+            let angle = bone.angle(&expected);
+            (bone.norm() == 0.0 || !(angle <= FRAMES_AGREE)).then(|| {
+                format!("its zero pose's {what} is {:.0}° from {}'s", angle.to_degrees(), self.name)
+            })
+        })
+    }
+}
 
 /// The human half of `bvh` (FK without a height override: the measured height).
 pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<HumanBody, Error> {
@@ -1159,9 +1228,10 @@ pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<Hu
 
 /// The config for retargeting `bvh` onto `model` when no config was written for the pair:
 /// - `given` (`--config`): as written, or bound to the skeleton when it is role-named;
-/// - `tuned` with `gmr` (`--gmr`): always the tuned config (GMR's exact behaviour);
-/// - `tuned` when the skeleton has its human body names and the same joint frames (every
-///   rotation offset within [`TUNED_AGREES`] of the derived config's): the tuned config;
+/// - `tuned` (a config written for [`LAFAN1_FRAMES`], as the shipped ones are) with `gmr`
+///   (`--gmr`): always the tuned config (GMR's exact behaviour);
+/// - `tuned` when the skeleton has its human body names and LAFAN1's joint frames
+///   ([`JointFrames::differs`]: a property of the skeleton, whatever the motion);
 /// - otherwise the config derived from the robot's and the skeleton's roles.
 ///
 /// `robot` names the robot in messages.
@@ -1189,45 +1259,35 @@ pub fn choose(
         let summary = format!("config {} (tuned; --gmr)", tuned.source);
         return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
     }
+    let mut why_not = String::new();
+    if let Some(tuned) = tuned {
+        let names = fk::body_names(bvh, fk_options)?;
+        if tuned.validate(model, &names).is_ok() {
+            let humanoid = fk::recognise(bvh, &fk_options.roles)?;
+            let frames = LAFAN1_FRAMES;
+            match frames.differs(&humanoid, fk_options.axes) {
+                None => {
+                    let summary = format!(
+                        "config {} (tuned: the skeleton has its names and {}'s joint frames)",
+                        tuned.source, frames.name
+                    );
+                    return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
+                }
+                Some(reason) => {
+                    why_not = format!(
+                        " (not the tuned {}: the skeleton has its names, but {reason})",
+                        tuned.source
+                    );
+                }
+            }
+        }
+    }
     let roles = RobotRoles::recognise(model)?;
     let human = human_body(bvh, fk_options, "the skeleton")?;
     let source = format!("<derived for {robot}>");
     let derived = derive(model, &roles, &human, &source)?;
-    if let Some(tuned) = tuned {
-        let names = fk::body_names(bvh, fk_options)?;
-        let names_fit = tuned.validate(model, &names).is_ok();
-        let angle = largest_offset_difference(tuned, &bind_names(&derived, tuned, &human));
-        if names_fit && angle.is_some_and(|a| a <= TUNED_AGREES) {
-            let summary = format!(
-                "config {} (tuned: the skeleton has its names and joint frames, within {:.0}°)",
-                tuned.source,
-                angle.unwrap_or(0.0).to_degrees()
-            );
-            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-        }
-    }
-    let summary = format!("config derived from the roles of {robot} and of the skeleton");
+    let summary = format!("config derived from the roles of {robot} and of the skeleton{why_not}");
     Ok(Chosen { config: derived, choice: Choice::Derived, summary })
-}
-
-/// `derived` with its robot bodies renamed to the ones `tuned` uses for the same human joint
-/// (GMR's configs pick other bodies for some roles, e.g. the N1's thigh roll link): offsets
-/// of different bodies are not comparable, so only shared (robot body, human joint) pairs
-/// count in [`largest_offset_difference`].
-/// Hands are left out: their canonical frame is the forearm's in the reference pose, so it
-/// carries whatever bend the subject's wrist had there.
-fn bind_names(derived: &IkConfig, tuned: &IkConfig, human: &HumanBody) -> IkConfig {
-    let hands: Vec<&String> =
-        [Role::LeftHand, Role::RightHand].iter().filter_map(|r| human.joints.get(r)).collect();
-    let mut out = derived.clone();
-    out.ik_match_table1.retain(|e| !hands.contains(&&e.human_body));
-    out.ik_match_table1.retain(|e| {
-        tuned
-            .ik_match_table1
-            .iter()
-            .any(|t| t.robot_body == e.robot_body && t.human_body == e.human_body)
-    });
-    out
 }
 
 /// Active entries of the first table (for tests and reports).

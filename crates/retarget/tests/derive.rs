@@ -5,7 +5,7 @@ mod shared;
 
 use std::path::PathBuf;
 
-use retarget::derive::{self, HumanBody};
+use retarget::derive::{self, Choice, HumanBody};
 use retarget::{IkConfig, RobotRoles};
 
 fn root() -> PathBuf {
@@ -112,4 +112,107 @@ fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
     let bhl = mjcf::Model::from_path(&path).unwrap();
     assert_eq!(pelvis_weights(&bhl, false), (100.0, 10.0));
     assert_eq!(pelvis_weights(&shipped("unitree_g1").0, true), (10.0, 5.0));
+}
+
+/// Whether a robot's tuned (GMR) config applies is a property of the skeleton, not of the
+/// motion or of the robot: on every robot with one, every LAFAN1 take (both samples and the
+/// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so
+/// do a LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright
+/// in its zero pose (the names fit, the joint frames are not LAFAN1's).
+#[test]
+fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
+    let Some(dir) = shared::shared_file("data/bvh") else { return };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .chain(std::fs::read_dir(root().join("data/samples")).into_iter().flatten())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 13, "{files:?}");
+    let clips: Vec<(String, bvh::Bvh)> = files
+        .iter()
+        .map(|f| {
+            let name = f.file_name().unwrap().to_string_lossy().into_owned();
+            (name, first_frames(bvh::from_path(f).unwrap(), 300))
+        })
+        .collect();
+    let upright = bvh::parse(upright_lafan1_named_bvh().as_bytes()).unwrap();
+    let default = fk::FkOptions::default();
+    let z_up = fk::FkOptions { axes: fk::AxisConvention::ZUp, ..fk::FkOptions::default() };
+    let mut lafan = 0;
+    for key in ["unitree_g1", "booster_t1_29dof", "fourier_n1", "engineai_pm01", "stanford_toddy"] {
+        let (model, tuned) = shipped(key);
+        let choose = |bvh: &bvh::Bvh, fk: &fk::FkOptions| {
+            derive::choose(&model, key, bvh, fk, None, Some(&tuned), false).unwrap()
+        };
+        for (name, bvh) in &clips {
+            let chosen = choose(bvh, &default);
+            let expected = if name.starts_with("lafan1") { Choice::Tuned } else { Choice::Derived };
+            assert_eq!(chosen.choice, expected, "{name} → {key}: {}", chosen.summary);
+            if expected == Choice::Tuned {
+                lafan += 1;
+                let turned = choose(bvh, &z_up);
+                assert_eq!(turned.choice, Choice::Derived, "{name} Z up → {key}");
+                assert!(turned.summary.contains("Z up from LAFAN1's +Y up"), "{}", turned.summary);
+            }
+        }
+        let chosen = choose(&upright, &default);
+        assert_eq!(chosen.choice, Choice::Derived, "upright → {key}: {}", chosen.summary);
+        assert!(chosen.summary.contains("from LAFAN1's"), "{}", chosen.summary);
+        // With --gmr the tuned config, whatever the skeleton (GMR's behaviour).
+        let gmr = derive::choose(&model, key, &upright, &default, None, Some(&tuned), true);
+        assert_eq!(gmr.unwrap().choice, Choice::Tuned);
+    }
+    assert!(lafan >= 5 * 4, "{lafan}: both samples and both shared LAFAN1 files");
+}
+
+fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
+    let n = n.min(bvh.motion.num_frames);
+    bvh.motion.num_frames = n;
+    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh
+}
+
+/// A skeleton with LAFAN1's joint names standing upright in its zero pose (Y up, cm): arms
+/// hanging, the toes forward (+Z); the pelvis sways sideways over a few frames.
+fn upright_lafan1_named_bvh() -> String {
+    let open = |name: &str, offset: &str| {
+        format!("JOINT {name}\n{{ OFFSET {offset} CHANNELS 3 Zrotation Yrotation Xrotation\n")
+    };
+    let chain = |joints: &[(String, String)], end: &str| {
+        let opened: String = joints.iter().map(|(n, o)| open(n, o)).collect();
+        opened + &format!("End Site\n{{ OFFSET {end} }}\n") + &"}\n".repeat(joints.len())
+    };
+    let leg = |side: &str, x: f64| {
+        let names = ["UpLeg", "Leg", "Foot", "Toe"].map(|p| format!("{side}{p}"));
+        let offsets = [format!("{x} 0 0"), "0 -43 0".into(), "0 -42 0".into(), "0 -6 14".into()];
+        chain(&names.into_iter().zip(offsets).collect::<Vec<_>>(), "0 0 5")
+    };
+    let arm = |side: &str, x: f64| {
+        let names = ["Shoulder", "Arm", "ForeArm", "Hand"].map(|p| format!("{side}{p}"));
+        let offsets = [
+            format!("{} 10 0", 4.0 * x),
+            format!("{} 0 0", 14.0 * x),
+            "0 -28 0".into(),
+            "0 -25 0".into(),
+        ];
+        chain(&names.into_iter().zip(offsets).collect::<Vec<_>>(), "0 -15 0")
+    };
+    let neck = [("Neck".into(), "0 15 0".into()), ("Head".into(), "0 10 0".into())];
+    let frames: String =
+        (0..30).map(|f| format!("{} 95 0 {}\n", f as f64 * 0.2, "0 ".repeat(66))).collect();
+    "HIERARCHY\nROOT Hips\n{ OFFSET 0 0 0 CHANNELS 6 Xposition Yposition Zposition Zrotation \
+     Yrotation Xrotation\n"
+        .to_owned()
+        + &leg("Left", 9.0)
+        + &leg("Right", -9.0)
+        + &open("Spine", "0 10 0")
+        + &open("Spine1", "0 12 0")
+        + &open("Spine2", "0 12 0")
+        + &chain(&neck, "0 15 0")
+        + &arm("Left", 1.0)
+        + &arm("Right", -1.0)
+        + "}\n}\n}\n}\nMOTION\nFrames: 30\nFrame Time: 0.033333\n"
+        + &frames
 }
