@@ -225,6 +225,9 @@ impl HumanBody {
                 *offset *= flat_foot(motion, b, *offset, ground + ankle + FLAT_FOOT);
             }
         }
+        for side in [Side::Left, Side::Right] {
+            flexion_twist(motion, &index, &mut frame_offsets, &picked, side);
+        }
         let mut sums: BTreeMap<Role, f64> = BTreeMap::new();
         let mut postures = Vec::with_capacity(picked.len());
         for &f in &picked {
@@ -290,6 +293,61 @@ fn flat_foot(
         .filter(|v| v.iter().all(|x| x.is_finite()))
         .sum();
     UnitQuaternion::rotation_between(&Vector3::z(), &up).unwrap_or_default()
+}
+
+/// The leg roles whose canonical frames [`flexion_twist`] turns about their bones: those
+/// [`limb_frames`] turns on the robot, but for the arms (measured: turning the human's upper
+/// arm by the elbow's flexion axis moves GMR's solve on ToddlerBot's sideways elbows onto a
+/// branch with the shoulder at its limits from the first frame).
+const FLEXION_TWISTED: [Part; 2] = [Part::Thigh, Part::Shin];
+
+/// A knee counts as bent enough to say which way it flexes when, over the sampled frames,
+/// the mean of `|thigh × shin|` is this share of the mean `|thigh| |shin|` (about 3°).
+const FLEXION_SEEN: f64 = 0.05;
+
+/// Turns the human's thigh and shin frames (`offsets`, [`fk::Humanoid::frame_offsets`])
+/// about their bones so that the knee flexes about their +y axis, on average over the
+/// `picked` frames weighted by how bent the knee is (the mean of `thigh × shin` seen from
+/// each frame). fk's limb frames take their twist from the body's forward direction in the
+/// reference pose, so they carry whatever hip rotation the subject had there (8–17° on the
+/// LAFAN1 takes); the robot's are turned by its knee axis ([`limb_frames`]), so both sides
+/// then agree on the flexion axis, and the robot's thighs and shins are asked for turns
+/// they can make (the G1's mean hip and knee rotation errors in GMR's solve of the jumps:
+/// 15° and 13° before, 9° and 5° after).
+fn flexion_twist(
+    motion: &HumanMotion,
+    index: &dyn Fn(Role) -> Option<usize>,
+    offsets: &mut BTreeMap<Role, UnitQuaternion<f64>>,
+    picked: &[usize],
+    side: Side,
+) {
+    let chain = [Part::Thigh, Part::Shin, Part::Foot].map(|p| index(Role::of(p, side)));
+    let [Some(hip), Some(knee), Some(ankle)] = chain else { return };
+    let bones: Vec<(usize, Vector3<f64>, Vector3<f64>)> = picked
+        .iter()
+        .map(|&f| {
+            let thigh = motion.position(f, knee) - motion.position(f, hip);
+            (f, thigh, motion.position(f, ankle) - motion.position(f, knee))
+        })
+        .filter(|(_, a, b)| a.iter().chain(b.iter()).all(|x| x.is_finite()))
+        .collect();
+    let lengths: f64 = bones.iter().map(|(_, a, b)| a.norm() * b.norm()).sum();
+    for part in FLEXION_TWISTED {
+        let role = Role::of(part, side);
+        let (Some(body), Some(offset)) = (index(role), offsets.get(&role).copied()) else {
+            continue;
+        };
+        let n: Vector3<f64> = bones
+            .iter()
+            .map(|(f, a, b)| (motion.orientation(*f, body) * offset).inverse() * a.cross(b))
+            .sum();
+        if !(n.x.hypot(n.y) > FLEXION_SEEN * lengths) {
+            continue;
+        }
+        // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to +y.
+        let theta = n.y.atan2(n.x) - std::f64::consts::FRAC_PI_2;
+        offsets.insert(role, offset * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta));
+    }
 }
 
 /// Whether the chest's canonical frame points more than 60° away from the pelvis's (z axes)
@@ -1353,6 +1411,54 @@ mod tests {
         assert!((fit.y - prior.y).abs() < 1e-9, "{fit:?}");
         // The right foot never touches: no fit.
         assert!(sole_fit(&[sole], &human, Role::RightFoot, 1.0, 1.0, prior).is_none());
+    }
+
+    /// A leg whose thigh and shin frames carry a 30° twist about the bone (as fk's do when
+    /// the subject's hip was turned in the reference pose), walking with the knee bending
+    /// about world +y: the twist is taken out, so the knee flexes about the frames' +y. A
+    /// leg that never bends is left as it is.
+    #[test]
+    fn flexion_twist_turns_thigh_and_shin_frames_to_the_knee_axis() {
+        let names = ["hip", "knee", "ankle"].map(str::to_owned).to_vec();
+        let frames = 20;
+        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
+        for f in 0..frames {
+            // The knee bends backward (the shin turns about +y) by 0..60°.
+            let bend = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), f as f64 * 0.05);
+            let knee = Vector3::new(0.0, 0.1, 0.5);
+            positions.extend([
+                Vector3::new(0.0, 0.1, 0.9),
+                knee,
+                knee + bend * Vector3::new(0.0, 0.0, -0.4),
+            ]);
+            orientations.extend([UnitQuaternion::identity(), bend, bend]);
+        }
+        let motion = HumanMotion {
+            fps: 30.0,
+            body_names: names,
+            num_frames: frames,
+            positions,
+            orientations,
+        };
+        let index = |role: Role| match role {
+            Role::LeftThigh => Some(0),
+            Role::LeftShin => Some(1),
+            Role::LeftFoot => Some(2),
+            _ => None,
+        };
+        let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 30f64.to_radians());
+        let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
+            [(Role::LeftThigh, twist), (Role::LeftShin, twist)].into_iter().collect();
+        let picked: Vec<usize> = (0..frames).collect();
+        flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left);
+        for role in [Role::LeftThigh, Role::LeftShin] {
+            assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
+        }
+        // Straight all along: nothing says how the knee flexes.
+        let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
+            [(Role::LeftThigh, twist)].into_iter().collect();
+        flexion_twist(&motion, &index, &mut offsets, &[0], Side::Left);
+        assert!((offsets[&Role::LeftThigh].angle() - 30f64.to_radians()).abs() < 1e-12);
     }
 
     #[test]
