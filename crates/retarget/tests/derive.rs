@@ -115,7 +115,7 @@ fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
 }
 
 /// Whether a robot's tuned (GMR) config applies is a property of the skeleton, not of the
-/// motion or of the robot: on every robot with one, every LAFAN1 take (both samples and the
+/// motion or of the robot: on every shipped robot (each has one), every LAFAN1 take (both samples and the
 /// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so
 /// do a LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright
 /// in its zero pose (the names fit, the joint frames are not LAFAN1's).
@@ -141,8 +141,10 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
     let default = fk::FkOptions::default();
     let z_up = fk::FkOptions { axes: fk::AxisConvention::ZUp, ..fk::FkOptions::default() };
     let mut lafan = 0;
-    for key in ["unitree_g1", "booster_t1_29dof", "fourier_n1", "engineai_pm01", "stanford_toddy"] {
-        let (model, tuned) = shipped(key);
+    let robots: Vec<_> = retarget::shipped::ROBOTS.iter().collect();
+    assert!(robots.len() >= 6, "the G1, H1, T1, N1, PM01 and ToddlerBot");
+    for robot in &robots {
+        let (key, model, tuned) = (robot.key, robot.model().unwrap(), robot.config().unwrap());
         let choose = |bvh: &bvh::Bvh, fk: &fk::FkOptions| {
             derive::choose(&model, key, bvh, fk, None, Some(&tuned), false).unwrap()
         };
@@ -164,7 +166,7 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
         let gmr = derive::choose(&model, key, &upright, &default, None, Some(&tuned), true);
         assert_eq!(gmr.unwrap().choice, Choice::Tuned);
     }
-    assert!(lafan >= 5 * 4, "{lafan}: both samples and both shared LAFAN1 files");
+    assert!(lafan >= robots.len() * 4, "{lafan}: both samples and both shared LAFAN1 files");
 }
 
 fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
