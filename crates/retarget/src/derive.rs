@@ -7,8 +7,9 @@
 //!
 //! - **Body ↔ joint**: the role's robot body tracks the role's human joint.
 //! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part,
-//!   except the feet's position weight: 100 as in GMR's configs for the T1, N1, PM01 and
-//!   ToddlerBot (the G1's has 50):
+//!   except the feet's position weight and the upper arm's rotation weights, which are
+//!   those of GMR's configs for the T1, N1, PM01 and ToddlerBot (the G1's and the H1's have
+//!   50 on the feet and 100 on the upper arms' rotation):
 //!
 //!   | part | table 1 pos | table 1 rot | table 2 pos | table 2 rot |
 //!   |---|---|---|---|---|
@@ -16,8 +17,14 @@
 //!   | thigh, shin | 0 | 10 | 10 | 5 |
 //!   | foot | 100 | 10 | 100 | 10 |
 //!   | chest | 0 | 100 | 0 | 10 |
-//!   | upper arm | 0 | 100 | 5 | 100 |
+//!   | upper arm | 0 | 10 | 5 | 10 |
 //!   | forearm, hand | 0 | 10 | 10 | 5 |
+//!
+//!   With 100 on the upper arms' rotation (measured with `scripts/compare-configs`), arms
+//!   that cannot take the human's orientation pull the whole robot on the jumps: in GMR's
+//!   solve the G1's hands were 86 mm from their targets against 72 mm with 10, the PM01's
+//!   feet 14 against 5 mm, and the default solve of the PM01 turned its left hip over into
+//!   a branch at its limits for the last half of the take.
 //!
 //! - **Rotation offset** `q_off = F_h ⊗ C_r⁻¹ ⊗ q_body`: `F_h = q_joint⁻¹ ⊗ C_h` is the
 //!   human's frame offset ([`fk::Humanoid::frame_offsets`], identity for the canonical human),
@@ -28,9 +35,12 @@
 //!   about +y and the elbow about −y of the thigh / upper arm frame (the flexion sense is the
 //!   larger side of the hinge's range from straight), which is where a human's knee and
 //!   elbow bend when the arm hangs: a robot whose elbow bends sideways at `qpos0`
-//!   (ToddlerBot's) then bends it forward with the human's; and the human's foot frame is
-//!   turned to lie flat on average over the frames where the foot is flat on the floor
-//!   (a reference pose on tiptoe would otherwise stand the robot on its toes).
+//!   (ToddlerBot's) then bends it forward with the human's; the human's thigh and shin are
+//!   turned likewise, so that the knee flexes about their +y on average over the clip
+//!   (fk's frames take their twist from the reference pose, which carries the subject's hip
+//!   rotation there); and the human's foot frame is turned to lie flat on average over the
+//!   frames where the foot is flat on the floor (a reference pose on tiptoe would otherwise
+//!   stand the robot on its toes).
 //! - **Position offset**, in the body's target frame, **fitted to the motion**: the offset
 //!   that puts the target where the robot's body is when the robot copies the human's
 //!   posture, averaged over up to 256 sampled frames. The copy: the robot's pelvis point at
@@ -40,9 +50,10 @@
 //!   GMR's scaling of the human joint. A foot's offset is fitted over the postures where
 //!   it is flat, and then so that the robot's **sole is on the floor** wherever the human's
 //!   foot touches it (flat, on the heel, on the ball): least squares of the sole's lowest
-//!   point over those postures, with the foot turned as the human's. A robot sole longer
-//!   than the scaled human foot is thereby moved back, so that its toe does not dig in when
-//!   the human rolls onto the ball. The canonical human has one posture (standing).
+//!   point over those postures, with the foot turned as the human's, put
+//!   [`SOLE_CLEARANCE`] above the floor. A robot sole longer than the scaled human foot is
+//!   thereby moved back, so that its toe does not dig in when the human rolls onto the
+//!   ball. The canonical human has one posture (standing).
 //! - **Scales**, robot over human: the root (pelvis) by the standing hip height (thigh +
 //!   shin + ankle height); the hip by its sideways offset from the pelvis point (midway
 //!   between the hips); the knee by the thigh, the foot by thigh + shin (with the root's
@@ -74,15 +85,16 @@ use crate::robot_roles::RobotRoles;
 
 use crate::Error;
 
-/// Weights per part (GMR's G1 config's, the feet's position GMR's other configs'):
-/// `[table1 pos, table1 rot, table2 pos, table2 rot]`.
+/// Weights per part (GMR's G1 config's; the feet's position and the upper arms' rotation
+/// GMR's other configs', see the module docs): `[table1 pos, table1 rot, table2 pos,
+/// table2 rot]`.
 pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
     (Part::Pelvis, [0.0, 10.0, 100.0, 5.0]),
     (Part::Thigh, [0.0, 10.0, 10.0, 5.0]),
     (Part::Shin, [0.0, 10.0, 10.0, 5.0]),
     (Part::Foot, [100.0, 10.0, 100.0, 10.0]),
     (Part::Chest, [0.0, 100.0, 0.0, 10.0]),
-    (Part::UpperArm, [0.0, 100.0, 5.0, 100.0]),
+    (Part::UpperArm, [0.0, 10.0, 5.0, 10.0]),
     (Part::Forearm, [0.0, 10.0, 10.0, 5.0]),
     (Part::Hand, [0.0, 10.0, 10.0, 5.0]),
 ];
@@ -779,7 +791,7 @@ fn fitted_offset(
 /// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor
 /// wherever the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the
 /// ball), with the foot turned as the human's: least squares over those postures of the
-/// sole's lowest point's height, `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
+/// sole's lowest point's height above [`SOLE_CLEARANCE`], `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
 /// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale`
 /// about the root). Flat postures fix the height; the postures on the heel or the ball fix
 /// how far forward the body sits (a robot sole longer than the scaled human foot is moved
@@ -813,7 +825,7 @@ fn sole_fit(
             continue;
         }
         normal += r * r.transpose();
-        rhs -= r * (a + low);
+        rhs -= r * (a + low - SOLE_CLEARANCE);
         n += 1;
     }
     if n == 0 {
@@ -826,6 +838,19 @@ fn sole_fit(
     let fit = normal.try_inverse()? * rhs;
     fit.iter().all(|v| v.is_finite()).then_some(fit)
 }
+
+/// Height (m) of the sole's lowest point above the floor that [`sole_fit`] aims at, the
+/// same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it in
+/// about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
+/// cannot follow the human's heel strike and toe-off. Measured on the five robots with GMR
+/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.6 to 3.6 points
+/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 2.9 →
+/// 1.3 %, ToddlerBot walk 5.7 → 3.0 %), while stance samples more than 2 cm above the floor
+/// stay fewer than with GMR's configs (at most 2.8 %); the report's sliding share rises by
+/// up to 0.6 points. The default solve moves every target onto its floor
+/// ([`crate::feet`]): there it changes the errors by less than 1 mm and the sliding share
+/// by at most 0.4 points.
+pub const SOLE_CLEARANCE: f64 = 0.003;
 
 /// Weight of the copy fit's horizontal foot offset in [`sole_fit`], as a share of the postures.
 const SOLE_PRIOR: f64 = 0.001;
@@ -1377,7 +1402,8 @@ mod tests {
 
     /// A human foot that stands flat, then rolls onto its ball (a pivot `l` ahead of the
     /// ankle and `h` below it): the robot's sole (a box reaching past the pivot) must end
-    /// up with its front bottom edge at the pivot, which is on the floor in every posture.
+    /// up with its front bottom edge at the pivot, which is on the floor in every posture
+    /// (the edge [`SOLE_CLEARANCE`] above it).
     #[test]
     fn the_sole_fit_puts_the_sole_on_the_floor_when_the_foot_rolls_onto_its_ball() {
         let (l, h) = (0.09, 0.07);
@@ -1403,10 +1429,10 @@ mod tests {
             .collect();
         let prior = Vector3::new(0.05, 0.01, 0.0);
         let fit = sole_fit(&[sole], &human, Role::LeftFoot, 1.0, 1.0, prior).unwrap();
-        // Body origin + front bottom edge (0.13, ·, −0.04) = pivot (l, ·, −h) from the ankle
-        // (to a few mm: the prior, 9 cm off, still pulls a little).
+        // Body origin + front bottom edge (0.13, ·, −0.04) = pivot (l, ·, −h) from the ankle,
+        // SOLE_CLEARANCE above it (to a few mm: the prior, 9 cm off, still pulls a little).
         assert!((fit.x - (l - 0.13)).abs() < 3e-3, "{fit:?}");
-        assert!((fit.z - (-h + 0.04)).abs() < 1e-3, "{fit:?}");
+        assert!((fit.z - (-h + 0.04 + SOLE_CLEARANCE)).abs() < 1e-3, "{fit:?}");
         // Tilts say nothing about the sideways offset: the prior's.
         assert!((fit.y - prior.y).abs() < 1e-9, "{fit:?}");
         // The right foot never touches: no fit.

@@ -218,3 +218,44 @@ fn upright_lafan1_named_bvh() -> String {
         + "}\n}\n}\n}\nMOTION\nFrames: 30\nFrame Time: 0.033333\n"
         + &frames
 }
+
+/// With GMR's solve the derived config's targets are within the robot's reach on the LAFAN1
+/// jumps, whole-body: the G1's hands within 10 % of the tuned config's (69 mm; 86 mm when
+/// the upper arms' rotation weighed 100 as in GMR's G1 config) and its feet within 4 mm;
+/// the PM01's feet within 8 mm (14 mm with the weight 100: its arms pulled the legs).
+#[test]
+fn the_derived_config_is_reachable_on_the_jumps() {
+    let sample = root().join("data/samples/lafan1_jumps.bvh");
+    let path = if sample.is_file() {
+        sample
+    } else {
+        let Some(p) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh") else {
+            return;
+        };
+        p
+    };
+    let bvh = bvh::from_path(&path).unwrap();
+    let human = derive::human_body(&bvh, &fk::FkOptions::default(), "jumps").unwrap();
+    for (key, hand_mm, foot_mm) in [("unitree_g1", 76.0, 4.0), ("engineai_pm01", 110.0, 8.0)] {
+        let (model, _) = shipped(key);
+        let roles = RobotRoles::recognise(&model).unwrap();
+        let config = derive::derive(&model, &roles, &human, key).unwrap();
+        let (_, diag) =
+            retarget::retarget_bvh(&bvh, &model, &config, &retarget::RetargetOptions::gmr())
+                .unwrap();
+        let stats = diag.position_error_stats();
+        let mean_of = |part: fk::Part| {
+            let bodies: Vec<f64> = [fk::Side::Left, fk::Side::Right]
+                .iter()
+                .map(|&side| {
+                    let body = roles.roles[&fk::Role::of(part, side)].name.as_str();
+                    let k = diag.body_names.iter().position(|b| b == body).unwrap();
+                    stats[k].0 * 1000.0
+                })
+                .collect();
+            bodies.iter().sum::<f64>() / 2.0
+        };
+        let (hand, foot) = (mean_of(fk::Part::Hand), mean_of(fk::Part::Foot));
+        assert!(hand < hand_mm && foot < foot_mm, "{key}: hands {hand:.1} mm, feet {foot:.1} mm");
+    }
+}
