@@ -7,9 +7,9 @@
 //!
 //! - **Body ↔ joint**: the role's robot body tracks the role's human joint.
 //! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part,
-//!   except the feet's position weight and the upper arm's rotation weights, which are
-//!   those of GMR's configs for the T1, N1, PM01 and ToddlerBot (the G1's and the H1's have
-//!   50 on the feet and 100 on the upper arms' rotation):
+//!   except the feet's position weight and the upper arm's rotation weight in table 2,
+//!   which are those of GMR's configs for the T1, N1, PM01 and ToddlerBot (the G1's and the
+//!   H1's have 50 on the feet and 100 on the upper arms' rotation in both tables):
 //!
 //!   | part | table 1 pos | table 1 rot | table 2 pos | table 2 rot |
 //!   |---|---|---|---|---|
@@ -17,14 +17,17 @@
 //!   | thigh, shin | 0 | 10 | 10 | 5 |
 //!   | foot | 100 | 10 | 100 | 10 |
 //!   | chest | 0 | 100 | 0 | 10 |
-//!   | upper arm | 0 | 10 | 5 | 10 |
+//!   | upper arm | 0 | 100 | 5 | 10 |
 //!   | forearm, hand | 0 | 10 | 10 | 5 |
 //!
-//!   With 100 on the upper arms' rotation (measured with `scripts/compare-configs`), arms
-//!   that cannot take the human's orientation pull the whole robot on the jumps: in GMR's
-//!   solve the G1's hands were 86 mm from their targets against 72 mm with 10, the PM01's
-//!   feet 14 against 5 mm, and the default solve of the PM01 turned its left hip over into
-//!   a branch at its limits for the last half of the take.
+//!   With 100 on the upper arms' rotation in table 2, the stage that also tracks positions
+//!   (measured with `scripts/compare-configs`), arms that cannot take the human's
+//!   orientation pull the whole robot on the jumps: in GMR's solve the G1's hands were
+//!   86 mm from their targets against 69 mm with 10, the PM01's feet 14 mm against 3 mm,
+//!   and the default solve of the PM01 turned its left hip over into a branch at its limits
+//!   for the last half of the take. Table 1 (orientations only) keeps the G1's 100: with 10
+//!   there too, the T1 no longer faces the way the human's pelvis does on a skeleton whose
+//!   pelvis frame is not upright (`scripts/check-any`, MocapBank).
 //!
 //! - **Rotation offset** `q_off = F_h ⊗ C_r⁻¹ ⊗ q_body`: `F_h = q_joint⁻¹ ⊗ C_h` is the
 //!   human's frame offset ([`fk::Humanoid::frame_offsets`], identity for the canonical human),
@@ -85,16 +88,16 @@ use crate::robot_roles::RobotRoles;
 
 use crate::Error;
 
-/// Weights per part (GMR's G1 config's; the feet's position and the upper arms' rotation
-/// GMR's other configs', see the module docs): `[table1 pos, table1 rot, table2 pos,
-/// table2 rot]`.
+/// Weights per part (GMR's G1 config's; the feet's position and the upper arms' rotation in
+/// table 2 GMR's other configs', see the module docs): `[table1 pos, table1 rot, table2
+/// pos, table2 rot]`.
 pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
     (Part::Pelvis, [0.0, 10.0, 100.0, 5.0]),
     (Part::Thigh, [0.0, 10.0, 10.0, 5.0]),
     (Part::Shin, [0.0, 10.0, 10.0, 5.0]),
     (Part::Foot, [100.0, 10.0, 100.0, 10.0]),
     (Part::Chest, [0.0, 100.0, 0.0, 10.0]),
-    (Part::UpperArm, [0.0, 10.0, 5.0, 10.0]),
+    (Part::UpperArm, [0.0, 100.0, 5.0, 10.0]),
     (Part::Forearm, [0.0, 10.0, 10.0, 5.0]),
     (Part::Hand, [0.0, 10.0, 10.0, 5.0]),
 ];
@@ -843,13 +846,13 @@ fn sole_fit(
 /// same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it in
 /// about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
 /// cannot follow the human's heel strike and toe-off. Measured on the five robots with GMR
-/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.6 to 3.6 points
-/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 2.9 →
-/// 1.3 %, ToddlerBot walk 5.7 → 3.0 %), while stance samples more than 2 cm above the floor
-/// stay fewer than with GMR's configs (at most 2.8 %); the report's sliding share rises by
-/// up to 0.6 points. The default solve moves every target onto its floor
-/// ([`crate::feet`]): there it changes the errors by less than 1 mm and the sliding share
-/// by at most 0.4 points.
+/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.7 to 3.6 points
+/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 3.2 →
+/// 1.3 %, ToddlerBot walk 6.2 → 3.2 %), while stance samples more than 2 cm above the floor
+/// stay fewer than with GMR's configs (at most 1.1 %); the report's sliding share moves by
+/// −1.3 to +0.6 points. The default solve moves every target onto its floor
+/// ([`crate::feet`]): there the errors move by at most 1 mm and the sliding share by at
+/// most 0.3 points.
 pub const SOLE_CLEARANCE: f64 = 0.003;
 
 /// Weight of the copy fit's horizontal foot offset in [`sole_fit`], as a share of the postures.

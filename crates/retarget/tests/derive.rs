@@ -221,8 +221,9 @@ fn upright_lafan1_named_bvh() -> String {
 
 /// With GMR's solve the derived config's targets are within the robot's reach on the LAFAN1
 /// jumps, whole-body: the G1's hands within 10 % of the tuned config's (69 mm; 86 mm when
-/// the upper arms' rotation weighed 100 as in GMR's G1 config) and its feet within 4 mm;
-/// the PM01's feet within 8 mm (14 mm with the weight 100: its arms pulled the legs).
+/// the upper arms' rotation weighed 100 in table 2 as in GMR's G1 config) and its feet
+/// within 4 mm; the PM01's feet within 8 mm (14 mm with that weight: its arms pulled the
+/// legs).
 #[test]
 fn the_derived_config_is_reachable_on_the_jumps() {
     let sample = root().join("data/samples/lafan1_jumps.bvh");
