@@ -356,7 +356,8 @@ fn flexion_twist(
             .iter()
             .map(|(f, a, b)| (motion.orientation(*f, body) * offset).inverse() * a.cross(b))
             .sum();
-        if !(n.x.hypot(n.y) > FLEXION_SEEN * lengths) {
+        let seen = n.x.hypot(n.y) > FLEXION_SEEN * lengths;
+        if !seen {
             continue;
         }
         // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to +y.
@@ -791,16 +792,16 @@ fn fitted_offset(
     Some(relative.inverse() * fit)
 }
 
-/// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor
-/// wherever the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the
-/// ball), with the foot turned as the human's: least squares over those postures of the
-/// sole's lowest point's height above [`SOLE_CLEARANCE`], `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
-/// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale`
-/// about the root). Flat postures fix the height; the postures on the heel or the ball fix
-/// how far forward the body sits (a robot sole longer than the scaled human foot is moved
-/// back, so that its toe does not dig in when the human rolls onto the ball). The horizontal
-/// offset stays near `prior` (the copy fit) where the postures do not decide it: a shift
-/// costs as much as the same height error in [`SOLE_PRIOR`] of the postures.
+/// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor wherever
+/// the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the ball), with the
+/// foot turned as the human's: least squares over those postures of the sole's lowest point's
+/// height above [`SOLE_CLEARANCE`], `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
+/// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale` about the
+/// root). Flat postures fix the height; the postures on the heel or the ball fix how far forward
+/// the body sits (a robot sole longer than the scaled human foot is moved back, so that its toe
+/// does not dig in when the human rolls onto the ball). The horizontal offset stays near `prior`
+/// (the copy fit) where the postures do not decide it: a shift costs as much as the same height
+/// error in [`SOLE_PRIOR`] of the postures.
 fn sole_fit(
     geoms: &[SoleGeom],
     human: &HumanBody,
@@ -842,9 +843,9 @@ fn sole_fit(
     fit.iter().all(|v| v.is_finite()).then_some(fit)
 }
 
-/// Height (m) of the sole's lowest point above the floor that [`sole_fit`] aims at, the
-/// same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it in
-/// about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
+/// Height (m) of the sole's lowest point above the floor that the foot offsets are fitted
+/// to, the same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it
+/// in about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
 /// cannot follow the human's heel strike and toe-off. Measured on the five robots with GMR
 /// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.7 to 3.6 points
 /// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 3.2 →
@@ -1296,7 +1297,8 @@ impl JointFrames {
         }
         checks.into_iter().find_map(|(what, bone, expected)| {
             let angle = bone.angle(&expected);
-            (bone.norm() == 0.0 || !(angle <= FRAMES_AGREE)).then(|| {
+            let agrees = angle <= FRAMES_AGREE;
+            (bone.norm() == 0.0 || !agrees).then(|| {
                 format!("its zero pose's {what} is {:.0}° from {}'s", angle.to_degrees(), self.name)
             })
         })

@@ -114,11 +114,11 @@ fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
     assert_eq!(pelvis_weights(&shipped("unitree_g1").0, true), (10.0, 5.0));
 }
 
-/// Whether a robot's tuned (GMR) config applies is a property of the skeleton, not of the
-/// motion or of the robot: on every shipped robot (each has one), every LAFAN1 take (both samples and the
-/// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so
-/// do a LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright
-/// in its zero pose (the names fit, the joint frames are not LAFAN1's).
+/// Whether a robot's tuned (GMR) config applies is a property of the skeleton, not of the motion or
+/// of the robot: on every shipped robot (each has one), every LAFAN1 take (both samples and the
+/// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so do a
+/// LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright in its zero
+/// pose (the names fit, the joint frames are not LAFAN1's).
 #[test]
 fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
     let Some(dir) = shared::shared_file("data/bvh") else { return };
