@@ -376,6 +376,11 @@ pub struct Humanoid {
     /// Head joint → pelvis → ankle along the bones (file units; both legs averaged): the
     /// body proportion the unit is chosen from, fingers and props not included.
     pub stature_path: f64,
+    /// Per role, its joint's position in the zero pose (all channels zero, OFFSETs only),
+    /// in file axes and units. Every joint's frame is the file's axes there, so these say
+    /// where the skeleton's joint frames sit on the body: two skeletons whose zero poses
+    /// point each bone the same way have the same joint frames.
+    pub rest_points: BTreeMap<Role, Vector3<f64>>,
 }
 
 /// One sampled frame: its index, positions and orientations of every joint.
@@ -432,6 +437,8 @@ pub(crate) fn recognise(
     let (reference, reference_reason) = reference(&key, samples, up, rest_pose);
     let frame_offsets = frame_offsets(&roles, samples, reference);
     let stature_path = stature_path(&tree, &key);
+    let rest_points =
+        roles.iter().filter_map(|(r, j)| Some((r, *samples.rest.get(j.index)?))).collect();
     Ok(Humanoid {
         convention: names.best.map(|c| CONVENTIONS[c].name),
         roles,
@@ -444,6 +451,7 @@ pub(crate) fn recognise(
         reference_reason,
         frame_offsets,
         stature_path,
+        rest_points,
     })
 }
 

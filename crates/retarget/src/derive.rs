@@ -7,8 +7,9 @@
 //!
 //! - **Body ↔ joint**: the role's robot body tracks the role's human joint.
 //! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part,
-//!   except the feet's position weight: 100 as in GMR's configs for the T1, N1, PM01 and
-//!   ToddlerBot (the G1's has 50):
+//!   except the feet's position weight and the upper arm's rotation weight in table 2,
+//!   which are those of GMR's configs for the T1, N1, PM01 and ToddlerBot (the G1's and the
+//!   H1's have 50 on the feet and 100 on the upper arms' rotation in both tables):
 //!
 //!   | part | table 1 pos | table 1 rot | table 2 pos | table 2 rot |
 //!   |---|---|---|---|---|
@@ -16,8 +17,17 @@
 //!   | thigh, shin | 0 | 10 | 10 | 5 |
 //!   | foot | 100 | 10 | 100 | 10 |
 //!   | chest | 0 | 100 | 0 | 10 |
-//!   | upper arm | 0 | 100 | 5 | 100 |
+//!   | upper arm | 0 | 100 | 5 | 10 |
 //!   | forearm, hand | 0 | 10 | 10 | 5 |
+//!
+//!   With 100 on the upper arms' rotation in table 2, the stage that also tracks positions
+//!   (measured with `scripts/compare-configs`), arms that cannot take the human's
+//!   orientation pull the whole robot on the jumps: in GMR's solve the G1's hands were
+//!   86 mm from their targets against 69 mm with 10, the PM01's feet 14 mm against 3 mm,
+//!   and the default solve of the PM01 turned its left hip over into a branch at its limits
+//!   for the last half of the take. Table 1 (orientations only) keeps the G1's 100: with 10
+//!   there too, the T1 no longer faces the way the human's pelvis does on a skeleton whose
+//!   pelvis frame is not upright (`scripts/check-any`, MocapBank).
 //!
 //! - **Rotation offset** `q_off = F_h ⊗ C_r⁻¹ ⊗ q_body`: `F_h = q_joint⁻¹ ⊗ C_h` is the
 //!   human's frame offset ([`fk::Humanoid::frame_offsets`], identity for the canonical human),
@@ -28,9 +38,12 @@
 //!   about +y and the elbow about −y of the thigh / upper arm frame (the flexion sense is the
 //!   larger side of the hinge's range from straight), which is where a human's knee and
 //!   elbow bend when the arm hangs: a robot whose elbow bends sideways at `qpos0`
-//!   (ToddlerBot's) then bends it forward with the human's; and the human's foot frame is
-//!   turned to lie flat on average over the frames where the foot is flat on the floor
-//!   (a reference pose on tiptoe would otherwise stand the robot on its toes).
+//!   (ToddlerBot's) then bends it forward with the human's; the human's thigh and shin are
+//!   turned likewise, so that the knee flexes about their +y on average over the clip
+//!   (fk's frames take their twist from the reference pose, which carries the subject's hip
+//!   rotation there); and the human's foot frame is turned to lie flat on average over the
+//!   frames where the foot is flat on the floor (a reference pose on tiptoe would otherwise
+//!   stand the robot on its toes).
 //! - **Position offset**, in the body's target frame, **fitted to the motion**: the offset
 //!   that puts the target where the robot's body is when the robot copies the human's
 //!   posture, averaged over up to 256 sampled frames. The copy: the robot's pelvis point at
@@ -40,9 +53,10 @@
 //!   GMR's scaling of the human joint. A foot's offset is fitted over the postures where
 //!   it is flat, and then so that the robot's **sole is on the floor** wherever the human's
 //!   foot touches it (flat, on the heel, on the ball): least squares of the sole's lowest
-//!   point over those postures, with the foot turned as the human's. A robot sole longer
-//!   than the scaled human foot is thereby moved back, so that its toe does not dig in when
-//!   the human rolls onto the ball. The canonical human has one posture (standing).
+//!   point over those postures, with the foot turned as the human's, put
+//!   [`SOLE_CLEARANCE`] above the floor. A robot sole longer than the scaled human foot is
+//!   thereby moved back, so that its toe does not dig in when the human rolls onto the
+//!   ball. The canonical human has one posture (standing).
 //! - **Scales**, robot over human: the root (pelvis) by the standing hip height (thigh +
 //!   shin + ankle height); the hip by its sideways offset from the pelvis point (midway
 //!   between the hips); the knee by the thigh, the foot by thigh + shin (with the root's
@@ -74,15 +88,16 @@ use crate::robot_roles::RobotRoles;
 
 use crate::Error;
 
-/// Weights per part (GMR's G1 config's, the feet's position GMR's other configs'):
-/// `[table1 pos, table1 rot, table2 pos, table2 rot]`.
+/// Weights per part (GMR's G1 config's; the feet's position and the upper arms' rotation in
+/// table 2 GMR's other configs', see the module docs): `[table1 pos, table1 rot, table2
+/// pos, table2 rot]`.
 pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
     (Part::Pelvis, [0.0, 10.0, 100.0, 5.0]),
     (Part::Thigh, [0.0, 10.0, 10.0, 5.0]),
     (Part::Shin, [0.0, 10.0, 10.0, 5.0]),
     (Part::Foot, [100.0, 10.0, 100.0, 10.0]),
     (Part::Chest, [0.0, 100.0, 0.0, 10.0]),
-    (Part::UpperArm, [0.0, 100.0, 5.0, 100.0]),
+    (Part::UpperArm, [0.0, 100.0, 5.0, 10.0]),
     (Part::Forearm, [0.0, 10.0, 10.0, 5.0]),
     (Part::Hand, [0.0, 10.0, 10.0, 5.0]),
 ];
@@ -225,6 +240,9 @@ impl HumanBody {
                 *offset *= flat_foot(motion, b, *offset, ground + ankle + FLAT_FOOT);
             }
         }
+        for side in [Side::Left, Side::Right] {
+            flexion_twist(motion, &index, &mut frame_offsets, &picked, side);
+        }
         let mut sums: BTreeMap<Role, f64> = BTreeMap::new();
         let mut postures = Vec::with_capacity(picked.len());
         for &f in &picked {
@@ -290,6 +308,62 @@ fn flat_foot(
         .filter(|v| v.iter().all(|x| x.is_finite()))
         .sum();
     UnitQuaternion::rotation_between(&Vector3::z(), &up).unwrap_or_default()
+}
+
+/// The leg roles whose canonical frames [`flexion_twist`] turns about their bones: those
+/// [`limb_frames`] turns on the robot, but for the arms (measured: turning the human's upper
+/// arm by the elbow's flexion axis moves GMR's solve on ToddlerBot's sideways elbows onto a
+/// branch with the shoulder at its limits from the first frame).
+const FLEXION_TWISTED: [Part; 2] = [Part::Thigh, Part::Shin];
+
+/// A knee counts as bent enough to say which way it flexes when, over the sampled frames,
+/// the mean of `|thigh × shin|` is this share of the mean `|thigh| |shin|` (about 3°).
+const FLEXION_SEEN: f64 = 0.05;
+
+/// Turns the human's thigh and shin frames (`offsets`, [`fk::Humanoid::frame_offsets`])
+/// about their bones so that the knee flexes about their +y axis, on average over the
+/// `picked` frames weighted by how bent the knee is (the mean of `thigh × shin` seen from
+/// each frame). fk's limb frames take their twist from the body's forward direction in the
+/// reference pose, so they carry whatever hip rotation the subject had there (8–17° on the
+/// LAFAN1 takes); the robot's are turned by its knee axis ([`limb_frames`]), so both sides
+/// then agree on the flexion axis, and the robot's thighs and shins are asked for turns
+/// they can make (the G1's mean hip and knee rotation errors in GMR's solve of the jumps:
+/// 15° and 13° before, 9° and 5° after).
+fn flexion_twist(
+    motion: &HumanMotion,
+    index: &dyn Fn(Role) -> Option<usize>,
+    offsets: &mut BTreeMap<Role, UnitQuaternion<f64>>,
+    picked: &[usize],
+    side: Side,
+) {
+    let chain = [Part::Thigh, Part::Shin, Part::Foot].map(|p| index(Role::of(p, side)));
+    let [Some(hip), Some(knee), Some(ankle)] = chain else { return };
+    let bones: Vec<(usize, Vector3<f64>, Vector3<f64>)> = picked
+        .iter()
+        .map(|&f| {
+            let thigh = motion.position(f, knee) - motion.position(f, hip);
+            (f, thigh, motion.position(f, ankle) - motion.position(f, knee))
+        })
+        .filter(|(_, a, b)| a.iter().chain(b.iter()).all(|x| x.is_finite()))
+        .collect();
+    let lengths: f64 = bones.iter().map(|(_, a, b)| a.norm() * b.norm()).sum();
+    for part in FLEXION_TWISTED {
+        let role = Role::of(part, side);
+        let (Some(body), Some(offset)) = (index(role), offsets.get(&role).copied()) else {
+            continue;
+        };
+        let n: Vector3<f64> = bones
+            .iter()
+            .map(|(f, a, b)| (motion.orientation(*f, body) * offset).inverse() * a.cross(b))
+            .sum();
+        let seen = n.x.hypot(n.y) > FLEXION_SEEN * lengths;
+        if !seen {
+            continue;
+        }
+        // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to +y.
+        let theta = n.y.atan2(n.x) - std::f64::consts::FRAC_PI_2;
+        offsets.insert(role, offset * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta));
+    }
 }
 
 /// Whether the chest's canonical frame points more than 60° away from the pelvis's (z axes)
@@ -718,16 +792,16 @@ fn fitted_offset(
     Some(relative.inverse() * fit)
 }
 
-/// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor
-/// wherever the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the
-/// ball), with the foot turned as the human's: least squares over those postures of the
-/// sole's lowest point's height, `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
-/// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale`
-/// about the root). Flat postures fix the height; the postures on the heel or the ball fix
-/// how far forward the body sits (a robot sole longer than the scaled human foot is moved
-/// back, so that its toe does not dig in when the human rolls onto the ball). The horizontal
-/// offset stays near `prior` (the copy fit) where the postures do not decide it: a shift
-/// costs as much as the same height error in [`SOLE_PRIOR`] of the postures.
+/// The offset of a foot (in its canonical frame) that puts the robot's sole on the floor wherever
+/// the human's foot touches it ([`Posture::feet_down`]: flat, on the heel, on the ball), with the
+/// foot turned as the human's: least squares over those postures of the sole's lowest point's
+/// height above [`SOLE_CLEARANCE`], `a + (C_h o)_z + low(C_h)` with `a` the target's height (GMR's
+/// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale` about the
+/// root). Flat postures fix the height; the postures on the heel or the ball fix how far forward
+/// the body sits (a robot sole longer than the scaled human foot is moved back, so that its toe
+/// does not dig in when the human rolls onto the ball). The horizontal offset stays near `prior`
+/// (the copy fit) where the postures do not decide it: a shift costs as much as the same height
+/// error in [`SOLE_PRIOR`] of the postures.
 fn sole_fit(
     geoms: &[SoleGeom],
     human: &HumanBody,
@@ -755,7 +829,7 @@ fn sole_fit(
             continue;
         }
         normal += r * r.transpose();
-        rhs -= r * (a + low);
+        rhs -= r * (a + low - SOLE_CLEARANCE);
         n += 1;
     }
     if n == 0 {
@@ -768,6 +842,19 @@ fn sole_fit(
     let fit = normal.try_inverse()? * rhs;
     fit.iter().all(|v| v.is_finite()).then_some(fit)
 }
+
+/// Height (m) of the sole's lowest point above the floor that the foot offsets are fitted
+/// to, the same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it
+/// in about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
+/// cannot follow the human's heel strike and toe-off. Measured on the five robots with GMR
+/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.7 to 3.6 points
+/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 3.2 →
+/// 1.3 %, ToddlerBot walk 6.2 → 3.2 %), while stance samples more than 2 cm above the floor
+/// stay fewer than with GMR's configs (at most 1.1 %); the report's sliding share moves by
+/// −1.3 to +0.6 points. The default solve moves every target onto its floor
+/// ([`crate::feet`]): there the errors move by at most 1 mm and the sliding share by at
+/// most 0.3 points.
+pub const SOLE_CLEARANCE: f64 = 0.003;
 
 /// Weight of the copy fit's horizontal foot offset in [`sole_fit`], as a share of the postures.
 const SOLE_PRIOR: f64 = 0.001;
@@ -989,21 +1076,6 @@ pub fn is_role_named(config: &IkConfig) -> bool {
     any
 }
 
-/// The largest angle (rad) between the rotation offsets `a` and `b` give the same robot body,
-/// over the bodies both track: how far apart two configs' ideas of the joint frames are.
-#[must_use]
-pub fn largest_offset_difference(a: &IkConfig, b: &IkConfig) -> Option<f64> {
-    let mut worst: Option<f64> = None;
-    for e in a.ik_match_table1.iter().filter(|e| e.is_active()) {
-        let Some(o) = b.ik_match_table1.iter().find(|o| o.robot_body == e.robot_body) else {
-            continue;
-        };
-        let angle = e.rot_offset.angle_to(&o.rot_offset);
-        worst = Some(worst.map_or(angle, |w: f64| w.max(angle)));
-    }
-    worst
-}
-
 /// The weights of `part` ([`WEIGHTS`]). A robot without a chest role (its arms hang from the
 /// pelvis body: no waist) tracks its pelvis with the larger of the pelvis's and the chest's
 /// weights: that body is its chest too, and with the pelvis's rotation weight (10) against
@@ -1144,9 +1216,94 @@ pub struct Chosen {
     pub summary: String,
 }
 
-/// Largest rotation-offset difference (rad) between a tuned config and the derived one for
-/// which the skeleton counts as the one the tuned config was written for.
-pub const TUNED_AGREES: f64 = 45.0 * std::f64::consts::PI / 180.0;
+/// The joint frames a tuned config was written for, as a skeleton's zero pose shows them:
+/// there every joint's frame is the file's axes, so the direction each bone points in (file
+/// axes) says where the joint frames sit on the body. Two skeletons with the same names,
+/// the same bone directions and the same up axis give the same joint rotations for the same
+/// posture, so a config's rotation offsets written for one hold for the other.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointFrames {
+    /// Whose frames these are, for messages.
+    pub name: &'static str,
+    /// Direction of every trunk and limb bone in the zero pose (file axes): pelvis → chest
+    /// → head, hip → knee → ankle → toe, shoulder → elbow → wrist.
+    pub bone: [f64; 3],
+    /// Direction from the right hip to the left one in the zero pose (file axes).
+    pub left: [f64; 3],
+    /// The file axis that points up in the motion (GMR converts it with its Y-up turn).
+    pub up: fk::UpAxis,
+}
+
+/// LAFAN1's joint frames (Ubisoft La Forge's skeleton), which GMR's `bvh_lafan1_to_*`
+/// configs, the tuned configs shipped, are written for: Y up; in the zero pose the skeleton
+/// lies along +X (every bone along its parent joint's +X), its left hip at +Z.
+pub const LAFAN1_FRAMES: JointFrames = JointFrames {
+    name: "LAFAN1",
+    bone: [1.0, 0.0, 0.0],
+    left: [0.0, 0.0, 1.0],
+    up: fk::UpAxis::PosY,
+};
+
+/// Largest angle between a zero-pose bone (or the hips) and the reference direction for
+/// which the joint frames count as the reference's: LAFAN1's own bones are within 5° of
+/// +X, a skeleton in another zero pose (standing in a T-pose, A-pose, arms down) has bones
+/// 90° off.
+pub const FRAMES_AGREE: f64 = 30.0 * std::f64::consts::PI / 180.0;
+
+/// The bones [`JointFrames::differs`] compares, as (from, to) roles; a pair with a role the
+/// skeleton lacks is skipped (the trunk then runs from the pelvis to the head).
+const FRAME_BONES: [(Role, Role); 13] = [
+    (Role::Pelvis, Role::Chest),
+    (Role::Chest, Role::Head),
+    (Role::LeftThigh, Role::LeftShin),
+    (Role::LeftShin, Role::LeftFoot),
+    (Role::LeftFoot, Role::LeftToe),
+    (Role::RightThigh, Role::RightShin),
+    (Role::RightShin, Role::RightFoot),
+    (Role::RightFoot, Role::RightToe),
+    (Role::LeftUpperArm, Role::LeftForearm),
+    (Role::LeftForearm, Role::LeftHand),
+    (Role::RightUpperArm, Role::RightForearm),
+    (Role::RightForearm, Role::RightHand),
+    (Role::Pelvis, Role::Head),
+];
+
+impl JointFrames {
+    /// `None` when `humanoid`, read with the axis convention `axes`, has these joint frames:
+    /// every bone of its zero pose ([`fk::Humanoid::rest_points`]) and its hips within
+    /// [`FRAMES_AGREE`] of these directions, and the file turned to Z up as these frames'
+    /// up axis is. Otherwise what differs.
+    #[must_use]
+    pub fn differs(&self, humanoid: &Humanoid, axes: fk::AxisConvention) -> Option<String> {
+        let axes = match axes {
+            fk::AxisConvention::Auto => humanoid.up.convention(),
+            given => given,
+        };
+        if axes != self.up.convention() {
+            return Some(format!("it is not turned to Z up from {}'s {} up", self.name, self.up));
+        }
+        let at = |r: &Role| humanoid.rest_points.get(r);
+        let chest = humanoid.rest_points.contains_key(&Role::Chest);
+        let mut checks: Vec<(String, Vector3<f64>, Vector3<f64>)> = FRAME_BONES
+            .iter()
+            .filter(|(from, to)| !(chest && *from == Role::Pelvis && *to == Role::Head))
+            .filter_map(|(from, to)| {
+                let bone = at(to)? - at(from)?;
+                Some((format!("{from} → {to}"), bone, Vector3::from(self.bone)))
+            })
+            .collect();
+        if let (Some(l), Some(r)) = (at(&Role::LeftThigh), at(&Role::RightThigh)) {
+            checks.push(("right → left hip".to_owned(), l - r, Vector3::from(self.left)));
+        }
+        checks.into_iter().find_map(|(what, bone, expected)| {
+            let angle = bone.angle(&expected);
+            let agrees = angle <= FRAMES_AGREE;
+            (bone.norm() == 0.0 || !agrees).then(|| {
+                format!("its zero pose's {what} is {:.0}° from {}'s", angle.to_degrees(), self.name)
+            })
+        })
+    }
+}
 
 /// The human half of `bvh` (FK without a height override: the measured height).
 pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<HumanBody, Error> {
@@ -1159,9 +1316,10 @@ pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<Hu
 
 /// The config for retargeting `bvh` onto `model` when no config was written for the pair:
 /// - `given` (`--config`): as written, or bound to the skeleton when it is role-named;
-/// - `tuned` with `gmr` (`--gmr`): always the tuned config (GMR's exact behaviour);
-/// - `tuned` when the skeleton has its human body names and the same joint frames (every
-///   rotation offset within [`TUNED_AGREES`] of the derived config's): the tuned config;
+/// - `tuned` (a config written for [`LAFAN1_FRAMES`], as the shipped ones are) with `gmr`
+///   (`--gmr`): always the tuned config (GMR's exact behaviour);
+/// - `tuned` when the skeleton has its human body names and LAFAN1's joint frames
+///   ([`JointFrames::differs`]: a property of the skeleton, whatever the motion);
 /// - otherwise the config derived from the robot's and the skeleton's roles.
 ///
 /// `robot` names the robot in messages.
@@ -1189,45 +1347,35 @@ pub fn choose(
         let summary = format!("config {} (tuned; --gmr)", tuned.source);
         return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
     }
+    let mut why_not = String::new();
+    if let Some(tuned) = tuned {
+        let names = fk::body_names(bvh, fk_options)?;
+        if tuned.validate(model, &names).is_ok() {
+            let humanoid = fk::recognise(bvh, &fk_options.roles)?;
+            let frames = LAFAN1_FRAMES;
+            match frames.differs(&humanoid, fk_options.axes) {
+                None => {
+                    let summary = format!(
+                        "config {} (tuned: the skeleton has its names and {}'s joint frames)",
+                        tuned.source, frames.name
+                    );
+                    return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
+                }
+                Some(reason) => {
+                    why_not = format!(
+                        " (not the tuned {}: the skeleton has its names, but {reason})",
+                        tuned.source
+                    );
+                }
+            }
+        }
+    }
     let roles = RobotRoles::recognise(model)?;
     let human = human_body(bvh, fk_options, "the skeleton")?;
     let source = format!("<derived for {robot}>");
     let derived = derive(model, &roles, &human, &source)?;
-    if let Some(tuned) = tuned {
-        let names = fk::body_names(bvh, fk_options)?;
-        let names_fit = tuned.validate(model, &names).is_ok();
-        let angle = largest_offset_difference(tuned, &bind_names(&derived, tuned, &human));
-        if names_fit && angle.is_some_and(|a| a <= TUNED_AGREES) {
-            let summary = format!(
-                "config {} (tuned: the skeleton has its names and joint frames, within {:.0}°)",
-                tuned.source,
-                angle.unwrap_or(0.0).to_degrees()
-            );
-            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-        }
-    }
-    let summary = format!("config derived from the roles of {robot} and of the skeleton");
+    let summary = format!("config derived from the roles of {robot} and of the skeleton{why_not}");
     Ok(Chosen { config: derived, choice: Choice::Derived, summary })
-}
-
-/// `derived` with its robot bodies renamed to the ones `tuned` uses for the same human joint
-/// (GMR's configs pick other bodies for some roles, e.g. the N1's thigh roll link): offsets
-/// of different bodies are not comparable, so only shared (robot body, human joint) pairs
-/// count in [`largest_offset_difference`].
-/// Hands are left out: their canonical frame is the forearm's in the reference pose, so it
-/// carries whatever bend the subject's wrist had there.
-fn bind_names(derived: &IkConfig, tuned: &IkConfig, human: &HumanBody) -> IkConfig {
-    let hands: Vec<&String> =
-        [Role::LeftHand, Role::RightHand].iter().filter_map(|r| human.joints.get(r)).collect();
-    let mut out = derived.clone();
-    out.ik_match_table1.retain(|e| !hands.contains(&&e.human_body));
-    out.ik_match_table1.retain(|e| {
-        tuned
-            .ik_match_table1
-            .iter()
-            .any(|t| t.robot_body == e.robot_body && t.human_body == e.human_body)
-    });
-    out
 }
 
 /// Active entries of the first table (for tests and reports).
@@ -1259,7 +1407,8 @@ mod tests {
 
     /// A human foot that stands flat, then rolls onto its ball (a pivot `l` ahead of the
     /// ankle and `h` below it): the robot's sole (a box reaching past the pivot) must end
-    /// up with its front bottom edge at the pivot, which is on the floor in every posture.
+    /// up with its front bottom edge at the pivot, which is on the floor in every posture
+    /// (the edge [`SOLE_CLEARANCE`] above it).
     #[test]
     fn the_sole_fit_puts_the_sole_on_the_floor_when_the_foot_rolls_onto_its_ball() {
         let (l, h) = (0.09, 0.07);
@@ -1285,14 +1434,62 @@ mod tests {
             .collect();
         let prior = Vector3::new(0.05, 0.01, 0.0);
         let fit = sole_fit(&[sole], &human, Role::LeftFoot, 1.0, 1.0, prior).unwrap();
-        // Body origin + front bottom edge (0.13, ·, −0.04) = pivot (l, ·, −h) from the ankle
-        // (to a few mm: the prior, 9 cm off, still pulls a little).
+        // Body origin + front bottom edge (0.13, ·, −0.04) = pivot (l, ·, −h) from the ankle,
+        // SOLE_CLEARANCE above it (to a few mm: the prior, 9 cm off, still pulls a little).
         assert!((fit.x - (l - 0.13)).abs() < 3e-3, "{fit:?}");
-        assert!((fit.z - (-h + 0.04)).abs() < 1e-3, "{fit:?}");
+        assert!((fit.z - (-h + 0.04 + SOLE_CLEARANCE)).abs() < 1e-3, "{fit:?}");
         // Tilts say nothing about the sideways offset: the prior's.
         assert!((fit.y - prior.y).abs() < 1e-9, "{fit:?}");
         // The right foot never touches: no fit.
         assert!(sole_fit(&[sole], &human, Role::RightFoot, 1.0, 1.0, prior).is_none());
+    }
+
+    /// A leg whose thigh and shin frames carry a 30° twist about the bone (as fk's do when
+    /// the subject's hip was turned in the reference pose), walking with the knee bending
+    /// about world +y: the twist is taken out, so the knee flexes about the frames' +y. A
+    /// leg that never bends is left as it is.
+    #[test]
+    fn flexion_twist_turns_thigh_and_shin_frames_to_the_knee_axis() {
+        let names = ["hip", "knee", "ankle"].map(str::to_owned).to_vec();
+        let frames = 20;
+        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
+        for f in 0..frames {
+            // The knee bends backward (the shin turns about +y) by 0..60°.
+            let bend = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), f as f64 * 0.05);
+            let knee = Vector3::new(0.0, 0.1, 0.5);
+            positions.extend([
+                Vector3::new(0.0, 0.1, 0.9),
+                knee,
+                knee + bend * Vector3::new(0.0, 0.0, -0.4),
+            ]);
+            orientations.extend([UnitQuaternion::identity(), bend, bend]);
+        }
+        let motion = HumanMotion {
+            fps: 30.0,
+            body_names: names,
+            num_frames: frames,
+            positions,
+            orientations,
+        };
+        let index = |role: Role| match role {
+            Role::LeftThigh => Some(0),
+            Role::LeftShin => Some(1),
+            Role::LeftFoot => Some(2),
+            _ => None,
+        };
+        let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 30f64.to_radians());
+        let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
+            [(Role::LeftThigh, twist), (Role::LeftShin, twist)].into_iter().collect();
+        let picked: Vec<usize> = (0..frames).collect();
+        flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left);
+        for role in [Role::LeftThigh, Role::LeftShin] {
+            assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
+        }
+        // Straight all along: nothing says how the knee flexes.
+        let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
+            [(Role::LeftThigh, twist)].into_iter().collect();
+        flexion_twist(&motion, &index, &mut offsets, &[0], Side::Left);
+        assert!((offsets[&Role::LeftThigh].angle() - 30f64.to_radians()).abs() < 1e-12);
     }
 
     #[test]

@@ -5,7 +5,7 @@ mod shared;
 
 use std::path::PathBuf;
 
-use retarget::derive::{self, HumanBody};
+use retarget::derive::{self, Choice, HumanBody};
 use retarget::{IkConfig, RobotRoles};
 
 fn root() -> PathBuf {
@@ -112,4 +112,151 @@ fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
     let bhl = mjcf::Model::from_path(&path).unwrap();
     assert_eq!(pelvis_weights(&bhl, false), (100.0, 10.0));
     assert_eq!(pelvis_weights(&shipped("unitree_g1").0, true), (10.0, 5.0));
+}
+
+/// Whether a robot's tuned (GMR) config applies is a property of the skeleton, not of the motion or
+/// of the robot: on every shipped robot (each has one), every LAFAN1 take (both samples and the
+/// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so do a
+/// LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright in its zero
+/// pose (the names fit, the joint frames are not LAFAN1's).
+#[test]
+fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
+    let Some(dir) = shared::shared_file("data/bvh") else { return };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .chain(std::fs::read_dir(root().join("data/samples")).into_iter().flatten())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 13, "{files:?}");
+    let clips: Vec<(String, bvh::Bvh)> = files
+        .iter()
+        .map(|f| {
+            let name = f.file_name().unwrap().to_string_lossy().into_owned();
+            (name, first_frames(bvh::from_path(f).unwrap(), 300))
+        })
+        .collect();
+    let upright = bvh::parse(upright_lafan1_named_bvh().as_bytes()).unwrap();
+    let default = fk::FkOptions::default();
+    let z_up = fk::FkOptions { axes: fk::AxisConvention::ZUp, ..fk::FkOptions::default() };
+    let mut lafan = 0;
+    let robots: Vec<_> = retarget::shipped::ROBOTS.iter().collect();
+    assert!(robots.len() >= 6, "the G1, H1, T1, N1, PM01 and ToddlerBot");
+    for robot in &robots {
+        let (key, model, tuned) = (robot.key, robot.model().unwrap(), robot.config().unwrap());
+        let choose = |bvh: &bvh::Bvh, fk: &fk::FkOptions| {
+            derive::choose(&model, key, bvh, fk, None, Some(&tuned), false).unwrap()
+        };
+        for (name, bvh) in &clips {
+            let chosen = choose(bvh, &default);
+            let expected = if name.starts_with("lafan1") { Choice::Tuned } else { Choice::Derived };
+            assert_eq!(chosen.choice, expected, "{name} → {key}: {}", chosen.summary);
+            if expected == Choice::Tuned {
+                lafan += 1;
+                let turned = choose(bvh, &z_up);
+                assert_eq!(turned.choice, Choice::Derived, "{name} Z up → {key}");
+                assert!(turned.summary.contains("Z up from LAFAN1's +Y up"), "{}", turned.summary);
+            }
+        }
+        let chosen = choose(&upright, &default);
+        assert_eq!(chosen.choice, Choice::Derived, "upright → {key}: {}", chosen.summary);
+        assert!(chosen.summary.contains("from LAFAN1's"), "{}", chosen.summary);
+        // With --gmr the tuned config, whatever the skeleton (GMR's behaviour).
+        let gmr = derive::choose(&model, key, &upright, &default, None, Some(&tuned), true);
+        assert_eq!(gmr.unwrap().choice, Choice::Tuned);
+    }
+    assert!(lafan >= robots.len() * 4, "{lafan}: both samples and both shared LAFAN1 files");
+}
+
+fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
+    let n = n.min(bvh.motion.num_frames);
+    bvh.motion.num_frames = n;
+    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh
+}
+
+/// A skeleton with LAFAN1's joint names standing upright in its zero pose (Y up, cm): arms
+/// hanging, the toes forward (+Z); the pelvis sways sideways over a few frames.
+fn upright_lafan1_named_bvh() -> String {
+    let open = |name: &str, offset: &str| {
+        format!("JOINT {name}\n{{ OFFSET {offset} CHANNELS 3 Zrotation Yrotation Xrotation\n")
+    };
+    let chain = |joints: &[(String, String)], end: &str| {
+        let opened: String = joints.iter().map(|(n, o)| open(n, o)).collect();
+        opened + &format!("End Site\n{{ OFFSET {end} }}\n") + &"}\n".repeat(joints.len())
+    };
+    let leg = |side: &str, x: f64| {
+        let names = ["UpLeg", "Leg", "Foot", "Toe"].map(|p| format!("{side}{p}"));
+        let offsets = [format!("{x} 0 0"), "0 -43 0".into(), "0 -42 0".into(), "0 -6 14".into()];
+        chain(&names.into_iter().zip(offsets).collect::<Vec<_>>(), "0 0 5")
+    };
+    let arm = |side: &str, x: f64| {
+        let names = ["Shoulder", "Arm", "ForeArm", "Hand"].map(|p| format!("{side}{p}"));
+        let offsets = [
+            format!("{} 10 0", 4.0 * x),
+            format!("{} 0 0", 14.0 * x),
+            "0 -28 0".into(),
+            "0 -25 0".into(),
+        ];
+        chain(&names.into_iter().zip(offsets).collect::<Vec<_>>(), "0 -15 0")
+    };
+    let neck = [("Neck".into(), "0 15 0".into()), ("Head".into(), "0 10 0".into())];
+    let frames: String =
+        (0..30).map(|f| format!("{} 95 0 {}\n", f as f64 * 0.2, "0 ".repeat(66))).collect();
+    "HIERARCHY\nROOT Hips\n{ OFFSET 0 0 0 CHANNELS 6 Xposition Yposition Zposition Zrotation \
+     Yrotation Xrotation\n"
+        .to_owned()
+        + &leg("Left", 9.0)
+        + &leg("Right", -9.0)
+        + &open("Spine", "0 10 0")
+        + &open("Spine1", "0 12 0")
+        + &open("Spine2", "0 12 0")
+        + &chain(&neck, "0 15 0")
+        + &arm("Left", 1.0)
+        + &arm("Right", -1.0)
+        + "}\n}\n}\n}\nMOTION\nFrames: 30\nFrame Time: 0.033333\n"
+        + &frames
+}
+
+/// With GMR's solve the derived config's targets are within the robot's reach on the LAFAN1
+/// jumps, whole-body: the G1's hands within 10 % of the tuned config's (69 mm; 86 mm when
+/// the upper arms' rotation weighed 100 in table 2 as in GMR's G1 config) and its feet
+/// within 4 mm; the PM01's feet within 8 mm (14 mm with that weight: its arms pulled the
+/// legs).
+#[test]
+fn the_derived_config_is_reachable_on_the_jumps() {
+    let sample = root().join("data/samples/lafan1_jumps.bvh");
+    let path = if sample.is_file() {
+        sample
+    } else {
+        let Some(p) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh") else {
+            return;
+        };
+        p
+    };
+    let bvh = bvh::from_path(&path).unwrap();
+    let human = derive::human_body(&bvh, &fk::FkOptions::default(), "jumps").unwrap();
+    for (key, hand_mm, foot_mm) in [("unitree_g1", 76.0, 4.0), ("engineai_pm01", 110.0, 8.0)] {
+        let (model, _) = shipped(key);
+        let roles = RobotRoles::recognise(&model).unwrap();
+        let config = derive::derive(&model, &roles, &human, key).unwrap();
+        let (_, diag) =
+            retarget::retarget_bvh(&bvh, &model, &config, &retarget::RetargetOptions::gmr())
+                .unwrap();
+        let stats = diag.position_error_stats();
+        let mean_of = |part: fk::Part| {
+            let bodies: Vec<f64> = [fk::Side::Left, fk::Side::Right]
+                .iter()
+                .map(|&side| {
+                    let body = roles.roles[&fk::Role::of(part, side)].name.as_str();
+                    let k = diag.body_names.iter().position(|b| b == body).unwrap();
+                    stats[k].0 * 1000.0
+                })
+                .collect();
+            bodies.iter().sum::<f64>() / 2.0
+        };
+        let (hand, foot) = (mean_of(fk::Part::Hand), mean_of(fk::Part::Foot));
+        assert!(hand < hand_mm && foot < foot_mm, "{key}: hands {hand:.1} mm, feet {foot:.1} mm");
+    }
 }
