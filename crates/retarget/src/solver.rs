@@ -226,8 +226,11 @@ impl<'m> Solver<'m> {
                 j.range.map(|range| Limit { joint: i, dof: j.dof_adr, qpos: j.qpos_adr, range })
             })
             .collect();
+        let parents = dof_parents(model);
         let mut qp = BoxQp::new(nv);
-        qp.set_tree(dof_parents(model));
+        qp.set_tree(parents.clone());
+        let mut dense = DenseQp::new(nv);
+        dense.set_tree(&parents);
         let mut solver = Solver {
             model,
             options,
@@ -244,7 +247,7 @@ impl<'m> Solver<'m> {
             qp_failures: 0,
             constraints: Vec::new(),
             dof_speed: vec![None; nv],
-            dense: DenseQp::new(nv),
+            dense,
             point_tasks: Vec::new(),
             body_dofs: (0..model.nbody())
                 .map(|b| {

@@ -12,11 +12,14 @@
 //! turn negative, so every iterate is dual feasible and the primal infeasibility falls
 //! monotonically; it ends at the exact KKT point or proves the problem infeasible. With
 //! `H = L Lᵀ` it keeps `J = L⁻ᵀ Q` and an upper-triangular `R` with `Jᵀ N = [R; 0]` (`N`: the
-//! active normals), updated by Givens rotations when a constraint enters or leaves.
+//! active normals), updated by Givens rotations when a constraint enters or leaves. On a
+//! kinematic tree's Hessian ([`DenseQp::set_tree`]) the factor is the tree's sparse
+//! `H = Lᵀ D L` instead and `J` starts as sparse `L⁻¹ D^-½`, so that the factorisation and
+//! the first rotations cost a fraction of the dense ones.
 //!
 //! Why this and not an interior-point crate: our problems are tiny (`n` = 35 for the G1,
 //! a few general rows active) and a step changes little between calls. The dual method costs
-//! one Cholesky factor and a few `O(n²)` updates per active constraint, and is exact;
+//! one factorisation and a few `O(n²)` updates per active constraint, and is exact;
 //! `benches/qp.rs` measures it against `clarabel` on QPs recorded from a G1 solve.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -67,6 +70,14 @@ pub struct DenseQp {
     z: Vec<f64>,
     dual_dir: Vec<f64>,
     normal: Vec<f64>,
+    /// Per variable, its ancestors nearest first in the tree declared by
+    /// [`DenseQp::set_tree`] (empty: no tree, dense factorisation).
+    chains: Vec<Vec<usize>>,
+    /// The tree factorisation `H = Lᵀ D L`: `L[k][i]` (unit lower triangular, non-zero only
+    /// for ancestors `i` of `k`) at `k n + i`, `D[k]` at `k n + k`.
+    tree_l: Vec<f64>,
+    /// Scratch: per variable, whether it descends from the column being inverted.
+    below: Vec<bool>,
     /// Constraints added or dropped in the last solve.
     pub iterations: usize,
 }
@@ -94,7 +105,34 @@ impl DenseQp {
             z: vec![0.0; n],
             dual_dir: vec![0.0; n],
             normal: vec![0.0; n],
+            chains: Vec::new(),
+            tree_l: Vec::new(),
+            below: Vec::new(),
             iterations: 0,
+        }
+    }
+
+    /// Declares that `h[i][j] ≠ 0` only when `i` and `j` are equal or one is an ancestor of
+    /// the other in the tree `parent` (parents have lower indices), as for [`BoxQp::set_tree`]:
+    /// true of a Hessian built from body Jacobians over MuJoCo's dof tree. The factorisation
+    /// is then MuJoCo's `mj_factorI` (`H = Lᵀ D L` eliminating leaves first, no fill-in) and
+    /// the starting `J = L⁻¹ D^-½` (also `J Jᵀ = H⁻¹`) is as sparse as the tree, which keeps
+    /// the first Givens updates short. Ignored unless `parent` has `n` entries, each lower
+    /// than its index.
+    ///
+    /// [`BoxQp::set_tree`]: super::BoxQp::set_tree
+    pub fn set_tree(&mut self, parent: &[Option<usize>]) {
+        let n = self.n;
+        let ok =
+            parent.len() == n && parent.iter().enumerate().all(|(i, p)| p.is_none_or(|p| p < i));
+        if ok {
+            self.chains = (0..n)
+                .map(|i| std::iter::successors(parent[i], |&p| parent[p]).collect())
+                .collect();
+            self.tree_l = vec![0.0; n * n];
+            self.below = vec![false; n];
+        } else {
+            self.chains.clear();
         }
     }
 
@@ -191,10 +229,15 @@ impl DenseQp {
         if !finite_data || !ordered_bounds {
             return QpStatus::Infeasible;
         }
-        if !self.factor() {
+        let tree = self.chains.len() == self.n;
+        if !(if tree { self.factor_tree() } else { self.factor() }) {
             return QpStatus::NotPositiveDefinite;
         }
-        self.unconstrained();
+        if tree {
+            self.unconstrained_tree();
+        } else {
+            self.unconstrained();
+        }
         let cap = 4 * (2 * self.n + m) + 20;
         while let Some((p, slack)) = self.most_violated() {
             match self.add_constraint(p, slack, cap) {
@@ -248,6 +291,91 @@ impl DenseQp {
         }
         self.r.fill(0.0);
         true
+    }
+
+    /// `H = Lᵀ D L` on the tree (`mj_factorI`: rows from the leaves up, each row's
+    /// elimination touching only its ancestors), then `J = L⁻¹ D^-½` by columns: column `k`
+    /// of `L⁻¹` is non-zero only on the descendants of `k` (`y_i = −Σ_j L[i][j] y_j` over
+    /// the ancestors `j ≥ k` of `i`).
+    fn factor_tree(&mut self) -> bool {
+        let n = self.n;
+        let (l, chains) = (&mut self.tree_l, &self.chains);
+        // Only the diagonal and the (lower-triangle) entries at ancestors are read or written.
+        for (k, chain) in chains.iter().enumerate() {
+            l[k * n + k] = self.h[k * n + k];
+            for &i in chain {
+                l[k * n + i] = self.h[k * n + i];
+            }
+        }
+        for k in (0..n).rev() {
+            let (above, rest) = l.split_at_mut(k * n);
+            let row_k = &mut rest[..n];
+            let dk = row_k[k];
+            if !(dk > 0.0 && dk.is_finite()) {
+                return false;
+            }
+            let chain = &chains[k];
+            for (a, &i) in chain.iter().enumerate() {
+                let tmp = row_k[i] / dk;
+                let row_i = &mut above[i * n..(i + 1) * n];
+                for &j in &chain[a..] {
+                    row_i[j] -= tmp * row_k[j];
+                }
+                row_k[i] = tmp;
+            }
+        }
+        let jt = &mut self.jt;
+        jt.fill(0.0);
+        for k in 0..n {
+            let col = &mut jt[k * n..(k + 1) * n];
+            col[k] = 1.0;
+            self.below.fill(false);
+            self.below[k] = true;
+            for i in k + 1..n {
+                // Descendants of k: the parent (the chain's first entry) descends from k.
+                if !chains[i].first().is_some_and(|&p| p >= k && self.below[p]) {
+                    continue;
+                }
+                self.below[i] = true;
+                let row_i = &l[i * n..(i + 1) * n];
+                let mut y = 0.0;
+                for &j in chains[i].iter().take_while(|&&j| j >= k) {
+                    y -= row_i[j] * col[j];
+                }
+                col[i] = y;
+            }
+            let scale = 1.0 / l[k * n + k].sqrt();
+            for v in &mut col[k..] {
+                *v *= scale;
+            }
+        }
+        self.r.fill(0.0);
+        true
+    }
+
+    /// `x = −H⁻¹ c` through the tree factorisation (`mj_solveM`).
+    fn unconstrained_tree(&mut self) {
+        let n = self.n;
+        let (l, x) = (&self.tree_l, &mut self.x);
+        for (xi, ci) in x.iter_mut().zip(&self.c) {
+            *xi = -ci;
+        }
+        for k in (0..n).rev() {
+            let xk = x[k];
+            for &i in &self.chains[k] {
+                x[i] -= l[k * n + i] * xk;
+            }
+        }
+        for k in 0..n {
+            x[k] /= l[k * n + k];
+        }
+        for k in 0..n {
+            let mut xk = x[k];
+            for &i in &self.chains[k] {
+                xk -= l[k * n + i] * x[i];
+            }
+            x[k] = xk;
+        }
     }
 
     /// `x = −J Jᵀ c`.
@@ -412,21 +540,33 @@ impl DenseQp {
         }
     }
 
-    /// Adds `con` (its `d = Jᵀ n` is in `self.d`): rotate `d[q+1..]` into `d[q]`, carrying
-    /// the rotations over to the columns of `J`; `R` gains the column `d[..=q]`.
+    /// Adds `con` (its `d = Jᵀ n` is in `self.d`): rotate the non-zeros of `d[q..]` into one
+    /// entry, pairwise from the last up, carrying each rotation over to the columns of `J`,
+    /// and swap that column to position `q` (any orthogonal map of `J`'s columns `q..` keeps
+    /// `Jᵀ N = [R; 0]`); `R` gains the column `d[..=q]`. With the tree's sparse `J` this is a
+    /// few rotations instead of `n − q`.
     fn push_active(&mut self, con: Con, multiplier: f64) {
         let n = self.n;
         let q = self.active.len();
-        for i in (q + 1..n).rev() {
-            let (a, b) = (self.d[i - 1], self.d[i]);
-            if b == 0.0 {
+        let mut kept: Option<usize> = None;
+        for i in (q..n).rev() {
+            if self.d[i] == 0.0 {
                 continue;
             }
-            let h = (a * a + b * b).sqrt(); // no overflow at these magnitudes; faster than hypot
-            let (cs, sn) = (a / h, b / h);
-            self.d[i - 1] = h;
-            self.d[i] = 0.0;
-            rotate_columns(&mut self.jt, n, i - 1, i, cs, sn);
+            if let Some(upper) = kept {
+                let (a, b) = (self.d[i], self.d[upper]);
+                let h = (a * a + b * b).sqrt(); // no overflow at these magnitudes; faster than hypot
+                let (cs, sn) = (a / h, b / h);
+                self.d[i] = h;
+                self.d[upper] = 0.0;
+                rotate_columns(&mut self.jt, n, i, upper, cs, sn);
+            }
+            kept = Some(i);
+        }
+        if let Some(p) = kept.filter(|&p| p != q) {
+            let (lo, hi) = self.jt.split_at_mut(p * n);
+            lo[q * n..(q + 1) * n].swap_with_slice(&mut hi[..n]);
+            self.d.swap(q, p);
         }
         self.r[q * n..q * n + q + 1].copy_from_slice(&self.d[..=q]);
         self.active.push(con);
@@ -476,7 +616,7 @@ impl DenseQp {
     }
 }
 
-/// Columns `a`, `b` of `J` become `c·Ja + s·Jb` and `−s·Ja + c·Jb`.
+/// Columns `a < b` of `J` become `c·Ja + s·Jb` and `−s·Ja + c·Jb`.
 fn rotate_columns(jt: &mut [f64], n: usize, a: usize, b: usize, cs: f64, sn: f64) {
     let (lo, hi) = jt.split_at_mut(b * n);
     let col_a = &mut lo[a * n..(a + 1) * n];
@@ -602,6 +742,83 @@ mod tests {
                 assert!((boxed.x[i] - dense.x[i]).abs() < 1e-8, "case {case}: {i}");
             }
         }
+    }
+
+    /// A random tree over `n` dofs (parents before children, several roots) and an `H`
+    /// with its sparsity: a sum of outer products of rows along root-to-leaf chains.
+    fn random_tree_problem(rng: &mut impl Rng, n: usize) -> (Vec<Option<usize>>, Vec<f64>) {
+        let parent: Vec<Option<usize>> = (0..n)
+            .map(|i| if i == 0 || rng.gen_bool(0.15) { None } else { Some(rng.gen_range(0..i)) })
+            .collect();
+        let mut h = vec![0.0; n * n];
+        for leaf in 0..n {
+            let chain: Vec<usize> = std::iter::successors(Some(leaf), |&d| parent[d]).collect();
+            for _ in 0..3 {
+                let row: Vec<f64> = chain.iter().map(|_| rng.gen_range(-1.0..1.0)).collect();
+                for (a, &i) in chain.iter().enumerate() {
+                    for (b, &j) in chain.iter().enumerate() {
+                        h[i * n + j] += row[a] * row[b];
+                    }
+                }
+            }
+        }
+        for i in 0..n {
+            h[i * n + i] += 0.05;
+        }
+        (parent, h)
+    }
+
+    /// The tree factorisation (and its sparse Givens updates) reaches the dense path's
+    /// minimiser, and KKT holds, with bounds and rows binding.
+    #[test]
+    fn tree_factorisation_matches_dense() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        for case in 0..300 {
+            let n = rng.gen_range(1..30);
+            let (parent, h) = random_tree_problem(&mut rng, n);
+            let mut dense = DenseQp::new(n);
+            dense.h = h;
+            dense.c = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();
+            let feasible: Vec<f64> = (0..n).map(|_| rng.gen_range(-0.5..0.5)).collect();
+            for ((lb, ub), f) in dense.lb.iter_mut().zip(dense.ub.iter_mut()).zip(&feasible) {
+                if rng.gen_bool(0.7) {
+                    *lb = f - rng.gen_range(0.0..1.0);
+                    *ub = f + rng.gen_range(0.0..1.0);
+                }
+            }
+            for _ in 0..rng.gen_range(0..n + 2) {
+                // Sparse rows, like a point's Jacobian along one chain.
+                let leaf = rng.gen_range(0..n);
+                let mut row = vec![0.0; n];
+                for d in std::iter::successors(Some(leaf), |&d| parent[d]) {
+                    row[d] = rng.gen_range(-1.0..1.0);
+                }
+                let b = dot(&row, &feasible) - rng.gen_range(0.0..0.3);
+                dense.add_row(b).copy_from_slice(&row);
+            }
+            if dense.num_rows() > 1 {
+                let (row, b) = (dense.a[..n].to_vec(), dense.b[0]);
+                dense.add_row(b).copy_from_slice(&row);
+            }
+            let mut tree = dense.clone();
+            tree.set_tree(&parent);
+            assert_eq!(tree.chains.len(), n);
+            assert_eq!(dense.solve(), QpStatus::Optimal, "case {case}");
+            assert_eq!(tree.solve(), QpStatus::Optimal, "case {case}");
+            assert_kkt(&tree, 1e-9);
+            for i in 0..n {
+                assert!((dense.x[i] - tree.x[i]).abs() < 1e-8, "case {case}: {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_parent_after_its_child_is_no_tree() {
+        let mut qp = DenseQp::new(2);
+        qp.set_tree(&[Some(1), None]);
+        assert!(qp.chains.is_empty());
+        qp.set_tree(&[None]);
+        assert!(qp.chains.is_empty());
     }
 
     /// Random bounds and rows around a feasible point: optimal, and KKT holds.
