@@ -13,7 +13,7 @@
 // guarantees them in range) and row buffers are sized `nv`.
 #![allow(clippy::indexing_slicing)]
 
-use mjcf::{Data, GeomType, Model};
+use mjcf::{Data, GeomType, Model, Proximity};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::qp::DenseQp;
@@ -43,8 +43,8 @@ pub struct Ground {
     geoms: Vec<usize>,
     pub floor: f64,
     pub activation: f64,
-    jacp: Vec<f64>,
-    jacr: Vec<f64>,
+    /// Scratch: one geom's candidate points.
+    points: Vec<Vector3<f64>>,
 }
 
 impl Ground {
@@ -54,13 +54,7 @@ impl Ground {
     #[must_use]
     pub fn new(model: &Model, floor: f64) -> Ground {
         let geoms = collision_primitives(model);
-        Ground {
-            geoms,
-            floor,
-            activation: 0.1,
-            jacp: vec![0.0; 3 * model.nv],
-            jacr: vec![0.0; 3 * model.nv],
-        }
+        Ground { geoms, floor, activation: 0.1, points: Vec::with_capacity(8) }
     }
 }
 
@@ -70,17 +64,18 @@ impl Constraint for Ground {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
-        let nv = ctx.model.nv;
-        let mut points = Vec::with_capacity(8);
         for &g in &self.geoms {
-            candidate_low_points(ctx.model, ctx.data, g, &mut points);
+            candidate_low_points(ctx.model, ctx.data, g, &mut self.points);
             let body = ctx.model.geoms[g].body;
-            for p in &points {
+            for p in &self.points {
                 if p.z > self.floor + self.activation {
                     continue;
                 }
-                ctx.model.jac(ctx.data, body, p, &mut self.jacp, &mut self.jacr);
-                qp.add_row(self.floor - p.z).copy_from_slice(&self.jacp[2 * nv..3 * nv]);
+                // The z row of the point's Jacobian (zero off the body's dof chain).
+                let row = qp.add_row(self.floor - p.z);
+                for (d, column) in ctx.model.jac_point_columns(ctx.data, body, *p) {
+                    row[d] = column.z;
+                }
             }
         }
     }
@@ -145,23 +140,19 @@ pub struct SelfCollision {
     radius: Vec<f64>,
     pub margin: f64,
     pub activation: f64,
-    jac1: Vec<f64>,
-    jac2: Vec<f64>,
-    jacr: Vec<f64>,
+    /// Scratch: geom 1's Jacobian columns.
+    columns: Vec<(usize, Vector3<f64>)>,
 }
 
 impl SelfCollision {
     #[must_use]
     pub fn new(model: &Model) -> SelfCollision {
-        let nv = model.nv;
         SelfCollision {
             pairs: model.self_collision_pairs().pairs,
             radius: model.geoms.iter().map(|g| g.bounding_radius().unwrap_or(0.0)).collect(),
             margin: 0.0,
             activation: 0.03,
-            jac1: vec![0.0; 3 * nv],
-            jac2: vec![0.0; 3 * nv],
-            jacr: vec![0.0; 3 * nv],
+            columns: Vec::with_capacity(model.nv),
         }
     }
 
@@ -169,6 +160,47 @@ impl SelfCollision {
     #[must_use]
     pub fn pairs(&self) -> &[[usize; 2]] {
         &self.pairs
+    }
+
+    /// The row of a pair in proximity `p`: `nᵀ (J₂ − J₁)` over both bodies' dof chains (zero
+    /// elsewhere).
+    fn fill_row(
+        &mut self,
+        ctx: &StepContext<'_>,
+        [g1, g2]: [usize; 2],
+        p: &Proximity,
+        row: &mut [f64],
+    ) {
+        let (model, data) = (ctx.model, ctx.data);
+        self.columns.clear();
+        self.columns.extend(model.jac_point_columns(data, model.geoms[g1].body, p.point1));
+        let mut first = self.columns.iter().peekable();
+        let mut second = model.jac_point_columns(data, model.geoms[g2].body, p.point2).peekable();
+        let zero = Vector3::zeros();
+        // Both chains run from the body towards the world (dofs descending): merge them.
+        loop {
+            let (d, j1, j2) = match (first.peek(), second.peek()) {
+                (Some(&&(d1, j1)), Some(&(d2, j2))) if d1 == d2 => {
+                    first.next();
+                    second.next();
+                    (d1, j1, j2)
+                }
+                (Some(&&(d1, j1)), Some(&(d2, _))) if d1 > d2 => {
+                    first.next();
+                    (d1, j1, zero)
+                }
+                (Some(&&(d1, j1)), None) => {
+                    first.next();
+                    (d1, j1, zero)
+                }
+                (_, Some(&(d2, j2))) => {
+                    second.next();
+                    (d2, zero, j2)
+                }
+                (None, None) => break,
+            };
+            row[d] = (0..3).map(|r| p.normal[r] * (j2[r] - j1[r])).sum();
+        }
     }
 }
 
@@ -179,8 +211,8 @@ impl Constraint for SelfCollision {
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
         let (model, data) = (ctx.model, ctx.data);
-        let nv = model.nv;
-        for &[g1, g2] in &self.pairs {
+        for k in 0..self.pairs.len() {
+            let [g1, g2] = self.pairs[k];
             let reach = self.radius[g1] + self.radius[g2] + self.activation;
             if (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared() > reach * reach {
                 continue;
@@ -188,14 +220,8 @@ impl Constraint for SelfCollision {
             let Some(p) = mjcf::geom_distance(model, data, g1, g2, self.activation) else {
                 continue;
             };
-            model.jac(data, model.geoms[g1].body, &p.point1, &mut self.jac1, &mut self.jacr);
-            model.jac(data, model.geoms[g2].body, &p.point2, &mut self.jac2, &mut self.jacr);
             let row = qp.add_row(self.margin - p.distance);
-            for (d, a) in row.iter_mut().enumerate() {
-                *a = (0..3)
-                    .map(|r| p.normal[r] * (self.jac2[r * nv + d] - self.jac1[r * nv + d]))
-                    .sum();
-            }
+            self.fill_row(ctx, [g1, g2], &p, row);
         }
     }
 }
