@@ -165,9 +165,6 @@ pub struct Solver<'m> {
     constraints_on: bool,
     /// This frame's point tasks ([`Solver::set_point_tasks`]).
     point_tasks: Vec<PointTask>,
-    /// Whether a general row was active in the last dense solve (then the next step goes
-    /// straight to the dense solver).
-    rows_bound: bool,
     /// The constraints' rows are linearised once per frame (and pass), at the first
     /// constrained step; later steps of the frame re-centre them on the configuration
     /// reached (`moved`: the sum of the steps since, tangent space). Whether they are made,
@@ -258,7 +255,6 @@ impl<'m> Solver<'m> {
                 .collect(),
             point_cols: Vec::with_capacity(nv),
             constraints_on: true,
-            rows_bound: false,
             rows_made: false,
             row_base: Vec::new(),
             row_ends: Vec::new(),
@@ -457,11 +453,12 @@ impl<'m> Solver<'m> {
         self.model.kinematics(&self.qpos, &mut self.data);
     }
 
-    /// The step under the general constraints, H, c and the bounds already in `self.qp`.
-    /// The box-only optimum is tried first: when it satisfies every row it is the optimum
-    /// of the constrained problem too. Otherwise the dense dual solver takes all of it; if
-    /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
-    /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
+    /// The step under the general constraints, H, c and the bounds already in `self.qp`,
+    /// solved by the dual active-set solver on the dof tree's factorisation (bounds and rows
+    /// alike: a bound entering the active set is a few `O(n)` updates, where the primal box
+    /// solver refactorises). If the constraints cannot hold together, the lowest-priority
+    /// ones are relaxed in turn: later constraints first, then the speed limits (see
+    /// [`Solver::add_constraint`]).
     fn constrained_step(&mut self) -> QpStatus {
         // Beyond this (rad or m, any coordinate) from where they were made, the rows are made
         // again. Held over any move, the linearisation took Fourier N1's walk from 8.9 to
@@ -490,25 +487,18 @@ impl<'m> Solver<'m> {
 
     /// [`Solver::constrained_step`] once the rows are in `self.dense`.
     fn constrained_solve(&mut self, ends: &[usize]) -> QpStatus {
-        // The box-only solve is cheaper; skip it while the rows keep binding.
-        if !self.rows_bound {
-            let status = self.qp.solve();
-            if status == QpStatus::Optimal && self.dense.rows_hold(&self.qp.x) {
-                self.dq.copy_from_slice(&self.qp.x);
-                return status;
-            }
-        }
-        self.dense.h.copy_from_slice(&self.qp.h);
-        self.dense.c.copy_from_slice(&self.qp.c);
-        self.dense.lb.copy_from_slice(&self.qp.lb);
-        self.dense.ub.copy_from_slice(&self.qp.ub);
+        // Hand the objective and bounds over without copying: every step rebuilds all four
+        // in `self.qp` (H and c from zero, the bounds from ±∞), whatever they held.
+        std::mem::swap(&mut self.dense.h, &mut self.qp.h);
+        std::mem::swap(&mut self.dense.c, &mut self.qp.c);
+        std::mem::swap(&mut self.dense.lb, &mut self.qp.lb);
+        std::mem::swap(&mut self.dense.ub, &mut self.qp.ub);
         let mut status = self.dense.solve();
         if status == QpStatus::Infeasible {
             self.relaxed_steps += 1;
             status = self.relax(ends);
         }
         self.dq.copy_from_slice(&self.dense.x);
-        self.rows_bound = (0..self.dense.num_rows()).any(|k| self.dense.row_is_active(k));
         status
     }
 

@@ -56,7 +56,7 @@ pub struct DenseQp {
     /// Rows taken into account: the first `in_use` ([`DenseQp::use_rows`]).
     in_use: usize,
     pub x: Vec<f64>,
-    /// `J` by columns: `jt[k n .. (k+1) n]` is column `k`.
+    /// `J` by columns (`Q` in tree mode): `jt[k n .. (k+1) n]` is column `k`.
     jt: Vec<f64>,
     /// `R` by columns: `r[k n + i] = R[i][k]`, upper triangular in the first `active.len()`.
     r: Vec<f64>,
@@ -73,11 +73,20 @@ pub struct DenseQp {
     /// Per variable, its ancestors nearest first in the tree declared by
     /// [`DenseQp::set_tree`] (empty: no tree, dense factorisation).
     chains: Vec<Vec<usize>>,
-    /// The tree factorisation `H = Lᵀ D L`: `L[k][i]` (unit lower triangular, non-zero only
-    /// for ancestors `i` of `k`) at `k n + i`, `D[k]` at `k n + k`.
+    /// The tree factorisation `H = Lᵀ D L` (`L` unit lower triangular, non-zero only at
+    /// `L[k][i]` for ancestors `i` of `k`), row `k` packed along its chain: `L[k][chains[k][a]]`
+    /// at `tree_start[k] + a`. Packed so, the ancestors of `chains[k][a]` are the rest of
+    /// `k`'s chain and the elimination updates contiguous slices. `D` apart.
     tree_l: Vec<f64>,
-    /// Scratch: per variable, whether it descends from the column being inverted.
-    below: Vec<bool>,
+    tree_start: Vec<usize>,
+    tree_d: Vec<f64>,
+    /// Tree mode: `J = L⁻¹ D^-½ Q` with `L⁻¹ D^-½` applied through the factor and only the
+    /// orthogonal `Q` (the Givens rotations so far) stored, by columns in `jt`: column `k`
+    /// is `e_k` until a rotation first touches it (`touched[k]`).
+    touched: Vec<bool>,
+    inv_sqrt_d: Vec<f64>,
+    /// Scratch for the tree solves.
+    w: Vec<f64>,
     /// Constraints added or dropped in the last solve.
     pub iterations: usize,
 }
@@ -107,7 +116,11 @@ impl DenseQp {
             normal: vec![0.0; n],
             chains: Vec::new(),
             tree_l: Vec::new(),
-            below: Vec::new(),
+            tree_start: Vec::new(),
+            tree_d: vec![0.0; n],
+            touched: vec![true; n],
+            inv_sqrt_d: vec![0.0; n],
+            w: vec![0.0; n],
             iterations: 0,
         }
     }
@@ -116,9 +129,10 @@ impl DenseQp {
     /// the other in the tree `parent` (parents have lower indices), as for [`BoxQp::set_tree`]:
     /// true of a Hessian built from body Jacobians over MuJoCo's dof tree. The factorisation
     /// is then MuJoCo's `mj_factorI` (`H = Lᵀ D L` eliminating leaves first, no fill-in) and
-    /// the starting `J = L⁻¹ D^-½` (also `J Jᵀ = H⁻¹`) is as sparse as the tree, which keeps
-    /// the first Givens updates short. Ignored unless `parent` has `n` entries, each lower
-    /// than its index.
+    /// `J = L⁻¹ D^-½ Q` (`J Jᵀ = H⁻¹` for any orthogonal `Q`) is never formed: products with
+    /// `L⁻¹ D^-½` are tree solves, and only `Q`, the identity until the Givens rotations of
+    /// the active set touch its columns, is stored. Ignored unless `parent` has `n` entries,
+    /// each lower than its index.
     ///
     /// [`BoxQp::set_tree`]: super::BoxQp::set_tree
     pub fn set_tree(&mut self, parent: &[Option<usize>]) {
@@ -129,8 +143,16 @@ impl DenseQp {
             self.chains = (0..n)
                 .map(|i| std::iter::successors(parent[i], |&p| parent[p]).collect())
                 .collect();
-            self.tree_l = vec![0.0; n * n];
-            self.below = vec![false; n];
+            self.tree_start = self
+                .chains
+                .iter()
+                .scan(0, |start, chain| {
+                    let at = *start;
+                    *start += chain.len();
+                    Some(at)
+                })
+                .collect();
+            self.tree_l = vec![0.0; self.chains.iter().map(Vec::len).sum()];
         } else {
             self.chains.clear();
         }
@@ -290,95 +312,147 @@ impl DenseQp {
             }
         }
         self.r.fill(0.0);
+        self.touched.fill(true);
         true
     }
 
     /// `H = Lᵀ D L` on the tree (`mj_factorI`: rows from the leaves up, each row's
-    /// elimination touching only its ancestors), then `J = L⁻¹ D^-½` by columns: column `k`
-    /// of `L⁻¹` is non-zero only on the descendants of `k` (`y_i = −Σ_j L[i][j] y_j` over
-    /// the ancestors `j ≥ k` of `i`).
+    /// elimination touching only its ancestors); `Q` starts as the identity.
     fn factor_tree(&mut self) -> bool {
         let n = self.n;
-        let (l, chains) = (&mut self.tree_l, &self.chains);
-        // Only the diagonal and the (lower-triangle) entries at ancestors are read or written.
-        for (k, chain) in chains.iter().enumerate() {
-            l[k * n + k] = self.h[k * n + k];
-            for &i in chain {
-                l[k * n + i] = self.h[k * n + i];
+        let (l, d) = (&mut self.tree_l, &mut self.tree_d);
+        for (k, (chain, &start)) in self.chains.iter().zip(&self.tree_start).enumerate() {
+            d[k] = self.h[k * n + k];
+            for (v, &i) in l[start..start + chain.len()].iter_mut().zip(chain) {
+                *v = self.h[k * n + i];
             }
         }
         for k in (0..n).rev() {
-            let (above, rest) = l.split_at_mut(k * n);
-            let row_k = &mut rest[..n];
-            let dk = row_k[k];
+            let dk = d[k];
             if !(dk > 0.0 && dk.is_finite()) {
                 return false;
             }
-            let chain = &chains[k];
+            let inv = 1.0 / dk;
+            let (chain, start) = (&self.chains[k], self.tree_start[k]);
+            // Row k lies after the rows of its ancestors (lower indices come first).
+            let (above, row_k) = l.split_at_mut(start);
+            let row_k = &mut row_k[..chain.len()];
+            // Ancestors nearest first: row k's entries above `i` are not scaled yet. The
+            // ancestors of `i = chain[a]` are `chain[a + 1..]`, in the same order.
             for (a, &i) in chain.iter().enumerate() {
-                let tmp = row_k[i] / dk;
-                let row_i = &mut above[i * n..(i + 1) * n];
-                for &j in &chain[a..] {
-                    row_i[j] -= tmp * row_k[j];
+                let tmp = row_k[a] * inv;
+                d[i] -= tmp * row_k[a];
+                let row_i =
+                    &mut above[self.tree_start[i]..self.tree_start[i] + chain.len() - a - 1];
+                for (x, y) in row_i.iter_mut().zip(&row_k[a + 1..]) {
+                    *x -= tmp * y;
                 }
-                row_k[i] = tmp;
+                row_k[a] = tmp;
             }
+            self.inv_sqrt_d[k] = 1.0 / dk.sqrt();
         }
-        let jt = &mut self.jt;
-        jt.fill(0.0);
-        for k in 0..n {
-            let col = &mut jt[k * n..(k + 1) * n];
-            col[k] = 1.0;
-            self.below.fill(false);
-            self.below[k] = true;
-            for i in k + 1..n {
-                // Descendants of k: the parent (the chain's first entry) descends from k.
-                if !chains[i].first().is_some_and(|&p| p >= k && self.below[p]) {
-                    continue;
-                }
-                self.below[i] = true;
-                let row_i = &l[i * n..(i + 1) * n];
-                let mut y = 0.0;
-                for &j in chains[i].iter().take_while(|&&j| j >= k) {
-                    y -= row_i[j] * col[j];
-                }
-                col[i] = y;
-            }
-            let scale = 1.0 / l[k * n + k].sqrt();
-            for v in &mut col[k..] {
-                *v *= scale;
-            }
-        }
+        self.touched.fill(false);
         self.r.fill(0.0);
         true
+    }
+
+    /// Row `k` of the packed `L` with its columns (`chains[k]`).
+    fn tree_row(&self, k: usize) -> impl Iterator<Item = (f64, usize)> + '_ {
+        let start = self.tree_start[k];
+        let chain = &self.chains[k];
+        self.tree_l[start..start + chain.len()].iter().copied().zip(chain.iter().copied())
+    }
+
+    /// Column `k` of `Q` holds `e_k` from now on if no rotation has touched it yet.
+    fn ready(&mut self, k: usize) {
+        let n = self.n;
+        if !self.touched[k] {
+            let col = &mut self.jt[k * n..(k + 1) * n];
+            col.fill(0.0);
+            col[k] = 1.0;
+            self.touched[k] = true;
+        }
+    }
+
+    /// Tree mode: `d = Jᵀ n_p = Qᵀ D^-½ L⁻ᵀ n_p` (`Lᵀ w = n_p` from the leaves up).
+    fn tree_dual(&mut self) {
+        let n = self.n;
+        let mut w = std::mem::take(&mut self.w);
+        w.copy_from_slice(&self.normal);
+        for k in (0..n).rev() {
+            let wk = w[k];
+            if wk != 0.0 {
+                for (lki, i) in self.tree_row(k) {
+                    w[i] -= lki * wk;
+                }
+            }
+        }
+        for (wk, s) in w.iter_mut().zip(&self.inv_sqrt_d) {
+            *wk *= s;
+        }
+        for k in 0..n {
+            self.d[k] = if self.touched[k] { dot(&self.jt[k * n..(k + 1) * n], &w) } else { w[k] };
+        }
+        self.w = w;
+    }
+
+    /// Tree mode: `z = J₂ d₂ = L⁻¹ D^-½ (Q₂ d₂)` (`L z = y` from the root down).
+    fn tree_primal(&mut self, q: usize) {
+        let n = self.n;
+        let mut y = std::mem::take(&mut self.w);
+        y.fill(0.0);
+        for k in q..n {
+            let dk = self.d[k];
+            if dk == 0.0 {
+                continue;
+            }
+            if self.touched[k] {
+                for (yi, qi) in y.iter_mut().zip(&self.jt[k * n..(k + 1) * n]) {
+                    *yi += dk * qi;
+                }
+            } else {
+                y[k] += dk;
+            }
+        }
+        let mut z = std::mem::take(&mut self.z);
+        for k in 0..n {
+            let mut zk = y[k] * self.inv_sqrt_d[k];
+            for (lki, i) in self.tree_row(k) {
+                zk -= lki * z[i];
+            }
+            z[k] = zk;
+        }
+        self.z = z;
+        self.w = y;
     }
 
     /// `x = −H⁻¹ c` through the tree factorisation (`mj_solveM`).
     fn unconstrained_tree(&mut self) {
         let n = self.n;
-        let (l, x) = (&self.tree_l, &mut self.x);
+        let mut x = std::mem::take(&mut self.x);
         for (xi, ci) in x.iter_mut().zip(&self.c) {
             *xi = -ci;
         }
         for k in (0..n).rev() {
             let xk = x[k];
-            for &i in &self.chains[k] {
-                x[i] -= l[k * n + i] * xk;
+            for (lki, i) in self.tree_row(k) {
+                x[i] -= lki * xk;
             }
         }
-        for k in 0..n {
-            x[k] /= l[k * n + k];
+        for (xk, dk) in x.iter_mut().zip(&self.tree_d) {
+            *xk /= dk;
         }
         for k in 0..n {
             let mut xk = x[k];
-            for &i in &self.chains[k] {
-                xk -= l[k * n + i] * x[i];
+            for (lki, i) in self.tree_row(k) {
+                xk -= lki * x[i];
             }
             x[k] = xk;
         }
+        self.x = x;
     }
 
-    /// `x = −J Jᵀ c`.
+    /// Dense mode: `x = −J Jᵀ c`.
     fn unconstrained(&mut self) {
         let n = self.n;
         self.x.fill(0.0);
@@ -456,7 +530,7 @@ impl DenseQp {
     /// Goldfarb–Idnani steps 2–3 for the violated constraint `p`: partial and full steps
     /// until `p` is satisfied and active.
     fn add_constraint(&mut self, p: Con, mut slack: f64, cap: usize) -> Result<(), QpStatus> {
-        let n = self.n;
+        let (n, tree) = (self.n, self.chains.len() == self.n);
         self.load_normal(p);
         let mut u_p = 0.0;
         loop {
@@ -466,27 +540,11 @@ impl DenseQp {
             }
             let q = self.active.len();
             // d = Jᵀ n_p; z = J₂ d₂ (primal direction); r = R⁻¹ d₁ (dual direction).
-            match p {
-                Con::Lower(i) | Con::Upper(i) => {
-                    let sign = if matches!(p, Con::Lower(_)) { 1.0 } else { -1.0 };
-                    for k in 0..n {
-                        self.d[k] = sign * self.jt[k * n + i];
-                    }
-                }
-                Con::Row(_) => {
-                    for k in 0..n {
-                        self.d[k] = dot(&self.jt[k * n..(k + 1) * n], &self.normal);
-                    }
-                }
-            }
-            self.z.fill(0.0);
-            for k in q..n {
-                let dk = self.d[k];
-                if dk != 0.0 {
-                    for (zi, ji) in self.z.iter_mut().zip(&self.jt[k * n..(k + 1) * n]) {
-                        *zi += dk * ji;
-                    }
-                }
+            if tree {
+                self.tree_dual();
+                self.tree_primal(q);
+            } else {
+                self.dense_directions(p, q);
             }
             for i in (0..q).rev() {
                 let mut s = self.d[i];
@@ -540,6 +598,33 @@ impl DenseQp {
         }
     }
 
+    /// Dense mode: `d = Jᵀ n_p` and `z = J₂ d₂` with `J` stored.
+    fn dense_directions(&mut self, p: Con, q: usize) {
+        let n = self.n;
+        match p {
+            Con::Lower(i) | Con::Upper(i) => {
+                let sign = if matches!(p, Con::Lower(_)) { 1.0 } else { -1.0 };
+                for k in 0..n {
+                    self.d[k] = sign * self.jt[k * n + i];
+                }
+            }
+            Con::Row(_) => {
+                for k in 0..n {
+                    self.d[k] = dot(&self.jt[k * n..(k + 1) * n], &self.normal);
+                }
+            }
+        }
+        self.z.fill(0.0);
+        for k in q..n {
+            let dk = self.d[k];
+            if dk != 0.0 {
+                for (zi, ji) in self.z.iter_mut().zip(&self.jt[k * n..(k + 1) * n]) {
+                    *zi += dk * ji;
+                }
+            }
+        }
+    }
+
     /// Adds `con` (its `d = Jᵀ n` is in `self.d`): rotate the non-zeros of `d[q..]` into one
     /// entry, pairwise from the last up, carrying each rotation over to the columns of `J`,
     /// and swap that column to position `q` (any orthogonal map of `J`'s columns `q..` keeps
@@ -554,6 +639,8 @@ impl DenseQp {
                 continue;
             }
             if let Some(upper) = kept {
+                self.ready(i);
+                self.ready(upper);
                 let (a, b) = (self.d[i], self.d[upper]);
                 let h = (a * a + b * b).sqrt(); // no overflow at these magnitudes; faster than hypot
                 let (cs, sn) = (a / h, b / h);
@@ -564,6 +651,8 @@ impl DenseQp {
             kept = Some(i);
         }
         if let Some(p) = kept.filter(|&p| p != q) {
+            self.ready(q);
+            self.ready(p);
             let (lo, hi) = self.jt.split_at_mut(p * n);
             lo[q * n..(q + 1) * n].swap_with_slice(&mut hi[..n]);
             self.d.swap(q, p);
@@ -601,6 +690,8 @@ impl DenseQp {
                 self.r[col * n + k + 1] = -sn * x + cs * y;
             }
             self.r[k * n + k + 1] = 0.0;
+            self.ready(k);
+            self.ready(k + 1);
             rotate_columns(&mut self.jt, n, k, k + 1, cs, sn);
         }
     }
