@@ -55,6 +55,12 @@ pub struct DenseQp {
     b: Vec<f64>,
     /// Rows taken into account: the first `in_use` ([`DenseQp::use_rows`]).
     in_use: usize,
+    /// Per row, its normal's length and whether every entry is finite, for the first
+    /// `checked` rows (rows are only appended or all cleared, and [`DenseQp::add_row`]'s
+    /// caller fills a row before the next solve, which checks the new ones).
+    row_norm: Vec<f64>,
+    row_finite: Vec<bool>,
+    checked: usize,
     pub x: Vec<f64>,
     /// `J` by columns (`Q` in tree mode): `jt[k n .. (k+1) n]` is column `k`.
     jt: Vec<f64>,
@@ -103,6 +109,9 @@ impl DenseQp {
             a: Vec::new(),
             b: Vec::new(),
             in_use: 0,
+            row_norm: Vec::new(),
+            row_finite: Vec::new(),
+            checked: 0,
             x: vec![0.0; n],
             jt: vec![0.0; n * n],
             r: vec![0.0; n * n],
@@ -168,6 +177,7 @@ impl DenseQp {
         self.a.clear();
         self.b.clear();
         self.in_use = 0;
+        self.checked = 0;
     }
 
     /// Takes only the first `k` rows into account from now on (all rows stay stored; a
@@ -244,8 +254,9 @@ impl DenseQp {
         self.row_active.clear();
         self.row_active.resize(self.b.len(), false);
         let m = self.in_use;
-        let finite_data = self.c.iter().chain(&self.b[..m]).chain(&self.a[..m * self.n]);
-        let finite_data = finite_data.into_iter().all(|v| v.is_finite());
+        self.check_rows();
+        let finite_data = self.c.iter().chain(&self.b[..m]).all(|v| v.is_finite())
+            && self.row_finite[..m].iter().all(|f| *f);
         let ordered_bounds =
             self.lb.iter().zip(&self.ub).all(|(l, u)| l <= u && *l < f64::INFINITY);
         if !finite_data || !ordered_bounds {
@@ -268,6 +279,19 @@ impl DenseQp {
             }
         }
         QpStatus::Optimal
+    }
+
+    /// Norms and finiteness of the rows added since the last check.
+    fn check_rows(&mut self) {
+        let n = self.n;
+        let rows = self.b.len();
+        self.row_norm.truncate(self.checked);
+        self.row_finite.truncate(self.checked);
+        for row in self.a[self.checked * n..rows * n].chunks_exact(n) {
+            self.row_norm.push(dot(row, row).sqrt());
+            self.row_finite.push(row.iter().all(|v| v.is_finite()));
+        }
+        self.checked = rows;
     }
 
     /// `H = L Lᵀ`, then `J = L⁻ᵀ` (its column `k` is row `k` of `L⁻¹`). Row slices and
@@ -501,7 +525,7 @@ impl DenseQp {
                 continue;
             }
             let row = &self.a[k * n..(k + 1) * n];
-            let norm = dot(row, row).sqrt();
+            let norm = self.row_norm[k];
             if norm == 0.0 {
                 continue; // 0 ≥ b: cannot be helped; a violated one stays violated
             }
