@@ -376,7 +376,8 @@ impl DenseQp {
             self.inv_sqrt_d[k] = 1.0 / dk.sqrt();
         }
         self.touched.fill(false);
-        self.r.fill(0.0);
+        // `R` needs no clearing: only entries written since (a column's rows up to its
+        // diagonal when it enters, kept so when columns move) are ever read.
         true
     }
 
