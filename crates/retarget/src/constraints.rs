@@ -41,6 +41,9 @@ pub trait Constraint: std::fmt::Debug + Send {
 #[derive(Debug, Clone)]
 pub struct Ground {
     geoms: Vec<usize>,
+    /// Bounding-sphere radius per geom of `geoms`: a geom whose sphere is above the
+    /// activation height has no candidate point below it either.
+    radius: Vec<f64>,
     pub floor: f64,
     pub activation: f64,
     /// Scratch: one geom's candidate points.
@@ -54,7 +57,11 @@ impl Ground {
     #[must_use]
     pub fn new(model: &Model, floor: f64) -> Ground {
         let geoms = collision_primitives(model);
-        Ground { geoms, floor, activation: 0.1, points: Vec::with_capacity(8) }
+        let radius = geoms
+            .iter()
+            .map(|&g| model.geoms[g].bounding_radius().unwrap_or(f64::INFINITY))
+            .collect();
+        Ground { geoms, radius, floor, activation: 0.1, points: Vec::with_capacity(8) }
     }
 }
 
@@ -64,11 +71,16 @@ impl Constraint for Ground {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
-        for &g in &self.geoms {
+        let top = self.floor + self.activation;
+        for (&g, &radius) in self.geoms.iter().zip(&self.radius) {
+            // (The margin covers the rounding of the candidate points.)
+            if ctx.data.geom_xpos[g].z - radius > top + 1e-9 {
+                continue;
+            }
             candidate_low_points(ctx.model, ctx.data, g, &mut self.points);
             let body = ctx.model.geoms[g].body;
             for p in &self.points {
-                if p.z > self.floor + self.activation {
+                if p.z > top {
                     continue;
                 }
                 // The z row of the point's Jacobian (zero off the body's dof chain).

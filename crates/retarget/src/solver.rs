@@ -121,8 +121,9 @@ struct TaskWork {
     scale: [f64; 6],
     /// Dofs moving the body (its Jacobian's non-zero columns), ascending.
     dofs: Vec<usize>,
-    /// Error at the current configuration.
+    /// Error at the current configuration, and the body's pose it was computed from.
     err: nalgebra::Vector6<f64>,
+    frame: Pose,
     /// Weighted Jacobian, one 6-column per dof of `dofs`.
     wjac: Vec<[f64; 6]>,
 }
@@ -210,6 +211,7 @@ impl<'m> Solver<'m> {
                     wjac: vec![[0.0; 6]; dofs.len()],
                     dofs,
                     err: nalgebra::Vector6::zeros(),
+                    frame: Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: nalgebra::Vector3::zeros() },
                 });
             }
             works.push(tasks);
@@ -403,7 +405,7 @@ impl<'m> Solver<'m> {
             let frame = self.body_pose(spec.body);
             let e = lie::rminus(&targets[spec.target], &frame);
             sum += e.norm_squared();
-            self.stages[s][k].err = e;
+            (self.stages[s][k].err, self.stages[s][k].frame) = (e, frame);
         }
         sum.sqrt()
     }
@@ -532,8 +534,8 @@ impl<'m> Solver<'m> {
         let nv = self.model.nv;
         let task = &self.stages[s][k];
         let body = task.spec.body;
-        let frame = self.body_pose(body);
-        let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &frame));
+        // The pose `stage_error` read at this configuration (every step follows one).
+        let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &task.frame));
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
         let task = &mut self.stages[s][k];

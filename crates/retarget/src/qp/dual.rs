@@ -60,6 +60,9 @@ pub struct DenseQp {
     /// caller fills a row before the next solve, which checks the new ones).
     row_norm: Vec<f64>,
     row_finite: Vec<bool>,
+    /// Per row, the range of its non-zero entries (a point's Jacobian row is zero beyond
+    /// its body's dof chain).
+    row_span: Vec<(usize, usize)>,
     checked: usize,
     pub x: Vec<f64>,
     /// `J` by columns (`Q` in tree mode): `jt[k n .. (k+1) n]` is column `k`.
@@ -111,6 +114,7 @@ impl DenseQp {
             in_use: 0,
             row_norm: Vec::new(),
             row_finite: Vec::new(),
+            row_span: Vec::new(),
             checked: 0,
             x: vec![0.0; n],
             jt: vec![0.0; n * n],
@@ -287,9 +291,13 @@ impl DenseQp {
         let rows = self.b.len();
         self.row_norm.truncate(self.checked);
         self.row_finite.truncate(self.checked);
+        self.row_span.truncate(self.checked);
         for row in self.a[self.checked * n..rows * n].chunks_exact(n) {
             self.row_norm.push(dot(row, row).sqrt());
             self.row_finite.push(row.iter().all(|v| v.is_finite()));
+            let first = row.iter().position(|v| *v != 0.0).unwrap_or(0);
+            let last = row.iter().rposition(|v| *v != 0.0).map_or(first, |i| i + 1);
+            self.row_span.push((first, last));
         }
         self.checked = rows;
     }
@@ -525,12 +533,13 @@ impl DenseQp {
             if self.row_active[k] {
                 continue;
             }
-            let row = &self.a[k * n..(k + 1) * n];
             let norm = self.row_norm[k];
             if norm == 0.0 {
                 continue; // 0 ≥ b: cannot be helped; a violated one stays violated
             }
-            let slack = dot(row, &self.x) - self.b[k];
+            let (first, last) = self.row_span[k];
+            let row = &self.a[k * n + first..k * n + last];
+            let slack = dot(row, &self.x[first..last]) - self.b[k];
             consider(Con::Row(k), slack, norm, self.b[k].abs());
         }
         worst
