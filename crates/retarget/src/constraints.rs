@@ -145,6 +145,13 @@ pub fn collision_primitives(model: &Model) -> Vec<usize> {
 /// Nothing through itself: every pair of [`Model::self_collision_pairs`] closer than
 /// `activation` keeps its signed distance at or above `margin`, linearised at the witness
 /// points: `d + nᵀ (J₂(p₂) − J₁(p₁)) Δq ≥ margin` (`n` from geom 1 to geom 2).
+///
+/// Pairs whose bounding spheres are farther apart than `activation` are left out first.
+/// Most pairs stay so for many calls: each pair remembers by how much its spheres cleared
+/// the activation distance when last tested, and each geom how far its centre has moved
+/// since the solver started (summed over the calls); a pair is tested again only once the
+/// two centres can have moved by its clearance. The same pairs reach the distance query as
+/// when every pair is tested.
 #[derive(Debug, Clone)]
 pub struct SelfCollision {
     pairs: Vec<[usize; 2]>,
@@ -152,6 +159,13 @@ pub struct SelfCollision {
     radius: Vec<f64>,
     pub margin: f64,
     pub activation: f64,
+    /// Per geom: its centre at the last call (none before the first) and the distance the
+    /// centre has moved over the calls so far.
+    centre: Vec<Option<Vector3<f64>>>,
+    travel: Vec<f64>,
+    /// Per pair: its spheres' clearance beyond `activation` when last tested plus both
+    /// geoms' `travel` then (−∞: test at the next call).
+    clear: Vec<f64>,
     /// Scratch: geom 1's Jacobian columns.
     columns: Vec<(usize, Vector3<f64>)>,
 }
@@ -159,11 +173,15 @@ pub struct SelfCollision {
 impl SelfCollision {
     #[must_use]
     pub fn new(model: &Model) -> SelfCollision {
+        let pairs = model.self_collision_pairs().pairs;
         SelfCollision {
-            pairs: model.self_collision_pairs().pairs,
             radius: model.geoms.iter().map(|g| g.bounding_radius().unwrap_or(0.0)).collect(),
             margin: 0.0,
             activation: 0.03,
+            centre: vec![None; model.geoms.len()],
+            travel: vec![0.0; model.geoms.len()],
+            clear: vec![f64::NEG_INFINITY; pairs.len()],
+            pairs,
             columns: Vec::with_capacity(model.nv),
         }
     }
@@ -222,13 +240,30 @@ impl Constraint for SelfCollision {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
+        // Below this clearance a pair is tested exactly (rounding of the bound).
+        const SLACK: f64 = 1e-9;
         let (model, data) = (ctx.model, ctx.data);
+        for ((centre, travel), now) in
+            self.centre.iter_mut().zip(&mut self.travel).zip(&data.geom_xpos)
+        {
+            if let Some(seen) = centre {
+                *travel += (now - *seen).norm();
+            }
+            *centre = Some(*now);
+        }
         for k in 0..self.pairs.len() {
             let [g1, g2] = self.pairs[k];
-            let reach = self.radius[g1] + self.radius[g2] + self.activation;
-            if (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared() > reach * reach {
+            let moved = self.travel[g1] + self.travel[g2];
+            if self.clear[k] - moved > SLACK {
                 continue;
             }
+            let reach = self.radius[g1] + self.radius[g2] + self.activation;
+            let apart = (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared();
+            if apart > reach * reach {
+                self.clear[k] = apart.sqrt() - reach + moved;
+                continue;
+            }
+            self.clear[k] = f64::NEG_INFINITY;
             let Some(p) = mjcf::geom_distance(model, data, g1, g2, self.activation) else {
                 continue;
             };

@@ -293,10 +293,12 @@ impl DenseQp {
         self.row_finite.truncate(self.checked);
         self.row_span.truncate(self.checked);
         for row in self.a[self.checked * n..rows * n].chunks_exact(n) {
-            self.row_norm.push(dot(row, row).sqrt());
-            self.row_finite.push(row.iter().all(|v| v.is_finite()));
+            // Zeros outside the span change neither the norm nor finiteness.
             let first = row.iter().position(|v| *v != 0.0).unwrap_or(0);
             let last = row.iter().rposition(|v| *v != 0.0).map_or(first, |i| i + 1);
+            let span = &row[first..last];
+            self.row_norm.push(dot(span, span).sqrt());
+            self.row_finite.push(span.iter().all(|v| v.is_finite()));
             self.row_span.push((first, last));
         }
         self.checked = rows;
