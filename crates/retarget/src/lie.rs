@@ -210,7 +210,14 @@ fn q_block(c: &Vector6<f64>) -> Matrix3<f64> {
 /// `rjacinv(τ) = ljacinv(−τ)` (eq. 179b).
 #[must_use]
 pub fn se3_jlog(p: &Pose) -> Matrix6<f64> {
-    let neg = -se3_log(p);
+    se3_jlog_at(&-se3_log(p))
+}
+
+/// [`se3_jlog`] from `neg = −log(p)` (`= log(p⁻¹)`), for a caller that has that logarithm
+/// already: `ljacinv(neg)`.
+#[must_use]
+pub fn se3_jlog_at(neg: &Vector6<f64>) -> Matrix6<f64> {
+    let neg = *neg;
     let w = Vector3::new(neg[3], neg[4], neg[5]);
     if w.dot(&w) < EPS {
         return Matrix6::identity();

@@ -50,6 +50,22 @@ pub struct SolverOptions {
     /// (GMR constructs a velocity limit but mink 1.3.0 ignores it, see `solve_ik`'s
     /// positional arguments). When set, `|q − q_previous frame| ≤ max_joint_speed · dt`.
     pub max_joint_speed: Option<f64>,
+    /// Whether the task terms follow mink operation by operation (GMR) or take shortcuts
+    /// that are equal to rounding.
+    pub arithmetic: Arithmetic,
+}
+
+/// How closely the solver follows mink's arithmetic ([`SolverOptions::arithmetic`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Arithmetic {
+    /// Operation by operation as mink: GMR's numbers, bit for bit (`--gmr`).
+    #[default]
+    Mink,
+    /// The same quantities in fewer operations, equal to rounding: a task's `Jlog` from the
+    /// error computed just before (`e = log(T_b⁻¹ T_t) = −log(T_t⁻¹ T_b)`, one SE(3)
+    /// logarithm per task and step fewer), body orientations from the kinematics'
+    /// quaternions instead of read back from the rotation matrices.
+    Lean,
 }
 
 impl Default for SolverOptions {
@@ -61,6 +77,7 @@ impl Default for SolverOptions {
             max_extra_steps: 10,
             limit_gain: 0.95,
             max_joint_speed: None,
+            arithmetic: Arithmetic::Mink,
         }
     }
 }
@@ -392,9 +409,17 @@ impl<'m> Solver<'m> {
         (steps, next)
     }
 
-    /// Frame pose as mink reads it: quaternion from `xmat`, position `xpos`.
+    /// Frame pose as mink reads it (quaternion from `xmat`), or the kinematics' own
+    /// quaternion ([`Arithmetic::Lean`]); position `xpos`.
     fn body_pose(&self, body: usize) -> Pose {
-        Pose { quat: lie::mat_to_quat(&self.data.xmat[body]), pos: self.data.xpos[body] }
+        let quat = match self.options.arithmetic {
+            Arithmetic::Mink => lie::mat_to_quat(&self.data.xmat[body]),
+            Arithmetic::Lean => {
+                let q = self.data.xquat[body];
+                [q.w, q.i, q.j, q.k]
+            }
+        };
+        Pose { quat, pos: self.data.xpos[body] }
     }
 
     /// Updates every task's error at the current configuration; returns the norm of all.
@@ -534,8 +559,13 @@ impl<'m> Solver<'m> {
         let nv = self.model.nv;
         let task = &self.stages[s][k];
         let body = task.spec.body;
-        // The pose `stage_error` read at this configuration (every step follows one).
-        let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &task.frame));
+        // The pose and error `stage_error` found at this configuration (every step follows one).
+        let jlog = match self.options.arithmetic {
+            Arithmetic::Mink => {
+                lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &task.frame))
+            }
+            Arithmetic::Lean => lie::se3_jlog_at(&task.err),
+        };
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
         let task = &mut self.stages[s][k];
