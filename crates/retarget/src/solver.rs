@@ -23,6 +23,8 @@
 // dof and qpos addresses) are in range by `mjcf::Model`'s construction.
 #![allow(clippy::indexing_slicing)]
 
+use std::ops::AddAssign;
+
 use mjcf::{Data, JointType, Model};
 
 use crate::constraints::{Constraint, StepContext};
@@ -177,8 +179,8 @@ pub struct Solver<'m> {
     dense: DenseQp,
     /// Dofs moving each body, ascending.
     body_dofs: Vec<Vec<usize>>,
-    /// Scratch: a point task's Jacobian columns, plain and weighted.
-    point_cols: Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)>,
+    /// Scratch: a body's Jacobian columns `J₆` and `M J₆` ([`Solver::add_point_tasks`]).
+    point_cols: Vec<(nalgebra::Vector6<f64>, nalgebra::Vector6<f64>)>,
     /// Whether the constraints are held ([`Solver::hold_constraints`]).
     constraints_on: bool,
     /// This frame's point tasks ([`Solver::set_point_tasks`]).
@@ -593,33 +595,58 @@ impl<'m> Solver<'m> {
     /// `w² JᵀJ` into H and `−w² Jᵀ e` into c for each point task (`J`: the point's
     /// translational Jacobian, `e = target − p`).
     /// Upper triangle only (dofs ascending; the caller mirrors H). Points on one body share
-    /// its Jacobian at the origin: a point `r` away moves by `J_p = J_o + J_ω × r`.
+    /// its Jacobian at the origin, `J_o` and `J_ω`: a point `r` away moves by
+    /// `J_o − [r]× J_ω = A J₆` (`A = [I, −[r]×]`, `J₆ = [J_o; J_ω]`), so the body's points
+    /// add `J₆ᵀ M J₆` with `M = Σ Aᵀ W A` (6 × 6) and `−J₆ᵀ Σ Aᵀ W e`: one pass over the
+    /// body's dof pairs whatever the number of points.
     fn add_point_tasks(&mut self) {
         let nv = self.model.nv;
         let mut k = 0;
         while k < self.point_tasks.len() {
             let b = self.point_tasks[k].body;
             self.model.jac_chain(&self.data, b, &mut self.jacp, &mut self.jacr);
-            let dofs = &self.body_dofs[b];
-            let origin = self.data.xpos[b];
+            let (origin, rotation) = (self.data.xpos[b], self.data.xmat[b]);
+            let mut m = nalgebra::Matrix6::<f64>::zeros();
+            let mut g = nalgebra::Vector6::<f64>::zeros();
             while let Some(task) = self.point_tasks.get(k).filter(|t| t.body == b) {
-                let r = self.data.xmat[b] * task.point;
+                let r = rotation * task.point;
                 let e = task.target - (origin + r);
-                let w2 = task.weight.component_mul(&task.weight);
-                self.point_cols.clear();
-                for &d in dofs {
-                    let col = |j: &[f64]| nalgebra::Vector3::new(j[d], j[nv + d], j[2 * nv + d]);
-                    let j = col(&self.jacp) + col(&self.jacr).cross(&r);
-                    self.point_cols.push((j, j.component_mul(&w2)));
-                }
-                for (a, (&da, (_, wa))) in dofs.iter().zip(&self.point_cols).enumerate() {
-                    self.qp.c[da] -= wa.dot(&e);
-                    let row = &mut self.qp.h[da * nv..(da + 1) * nv];
-                    for (&db, (jb, _)) in dofs[a..].iter().zip(&self.point_cols[a..]) {
-                        row[db] += wa.dot(jb);
-                    }
-                }
+                let w = nalgebra::Matrix3::from_diagonal(&task.weight.component_mul(&task.weight));
+                let s = r.cross_matrix();
+                let ws = w * s;
+                // Aᵀ W A = [[W, −W S], [−Sᵀ W, Sᵀ W S]], Aᵀ W e = [W e; −Sᵀ W e] (S = [r]×).
+                let mut block = |row: usize, col: usize, v: &nalgebra::Matrix3<f64>| {
+                    let mut view = m.fixed_view_mut::<3, 3>(row, col);
+                    view += v;
+                };
+                block(0, 0, &w);
+                block(0, 3, &-ws);
+                block(3, 0, &-ws.transpose());
+                block(3, 3, &(s.transpose() * ws));
+                let we = w * e;
+                g.fixed_rows_mut::<3>(0).add_assign(&we);
+                g.fixed_rows_mut::<3>(3).add_assign(&r.cross(&we));
                 k += 1;
+            }
+            let dofs = &self.body_dofs[b];
+            self.point_cols.clear();
+            for &d in dofs {
+                let j = nalgebra::Vector6::new(
+                    self.jacp[d],
+                    self.jacp[nv + d],
+                    self.jacp[2 * nv + d],
+                    self.jacr[d],
+                    self.jacr[nv + d],
+                    self.jacr[2 * nv + d],
+                );
+                self.point_cols.push((j, m * j));
+            }
+            for (a, (&da, (ja, _))) in dofs.iter().zip(&self.point_cols).enumerate() {
+                self.qp.c[da] -= ja.dot(&g);
+                let row = &mut self.qp.h[da * nv..(da + 1) * nv];
+                for (&db, (_, mb)) in dofs[a..].iter().zip(&self.point_cols[a..]) {
+                    row[db] += ja.dot(mb);
+                }
             }
         }
     }
