@@ -347,9 +347,19 @@ pub fn geom_distance(
 }
 
 /// Half the extent of a placed primitive along the unit direction `u` (all primitives are
-/// symmetric about their centre): `u · support(u)` from the centre, plus the radius.
+/// symmetric about their centre): `u · support(u)` from the centre, plus the radius, in
+/// closed form on `u`'s components in the geom's frame.
+#[inline]
 fn half_extent(p: &Placed, u: &Vector3<f64>) -> f64 {
-    u.dot(&(p.rot * p.core.support(&p.rot.tr_mul(u)))) + p.radius
+    let local = p.rot.tr_mul(u);
+    let core = match p.core {
+        Core::Point => 0.0,
+        Core::Segment(h) => h * local.z.abs(),
+        Core::Box(s) => s.x * local.x.abs() + s.y * local.y.abs() + s.z * local.z.abs(),
+        Core::Cylinder(r, h) => h * local.z.abs() + r * local.x.hypot(local.y),
+        Core::Ellipsoid(s) => s.component_mul(&local).norm(),
+    };
+    core + p.radius
 }
 
 /// A lower bound of the signed distance of two placed primitives, by separating axes: along
