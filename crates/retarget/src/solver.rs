@@ -446,9 +446,10 @@ impl<'m> Solver<'m> {
             mu_total += self.task_objective(s, k, targets);
         }
         self.add_point_tasks();
-        self.finish_hessian(self.options.damping + mu_total);
+        self.add_diagonal(self.options.damping + mu_total);
         self.set_bounds(dt);
         let status = if self.constraints.is_empty() || !self.constraints_on {
+            self.mirror_hessian();
             let status = self.qp.solve();
             self.dq.copy_from_slice(&self.qp.x);
             status
@@ -464,11 +465,19 @@ impl<'m> Solver<'m> {
         self.take_step();
     }
 
-    /// Adds `diagonal` to H's diagonal and mirrors its upper triangle into the lower one.
-    fn finish_hessian(&mut self, diagonal: f64) {
+    /// Adds `diagonal` to H's diagonal.
+    fn add_diagonal(&mut self, diagonal: f64) {
         let nv = self.model.nv;
         for d in 0..nv {
             self.qp.h[d * nv + d] += diagonal;
+        }
+    }
+
+    /// Mirrors H's upper triangle (where the terms are added) into the lower one, for the
+    /// box solver, which reads whole rows ([`DenseQp`] reads the upper triangle).
+    fn mirror_hessian(&mut self) {
+        let nv = self.model.nv;
+        for d in 0..nv {
             for e in 0..d {
                 self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
             }
@@ -581,7 +590,7 @@ impl<'m> Solver<'m> {
         }
         let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
-        // Upper triangle only (dofs ascending); `step` mirrors it.
+        // Upper triangle only (dofs ascending); mirrored for the box solver.
         for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
             self.qp.c[da] -= dot6(&we, col_a);
             let row = &mut self.qp.h[da * nv..(da + 1) * nv];
@@ -594,7 +603,7 @@ impl<'m> Solver<'m> {
 
     /// `w² JᵀJ` into H and `−w² Jᵀ e` into c for each point task (`J`: the point's
     /// translational Jacobian, `e = target − p`).
-    /// Upper triangle only (dofs ascending; the caller mirrors H). Points on one body share
+    /// Upper triangle only (dofs ascending). Points on one body share
     /// its Jacobian at the origin, `J_o` and `J_ω`: a point `r` away moves by
     /// `J_o − [r]× J_ω = A J₆` (`A = [I, −[r]×]`, `J₆ = [J_o; J_ω]`), so the body's points
     /// add `J₆ᵀ M J₆` with `M = Σ Aᵀ W A` (6 × 6) and `−J₆ᵀ Σ Aᵀ W e`: one pass over the
@@ -716,7 +725,7 @@ impl<'m> Solver<'m> {
 
             self.add_posture(reference, weight);
             self.add_point_tasks();
-            self.finish_hessian(self.options.damping);
+            self.add_diagonal(self.options.damping);
             self.set_bounds(dt);
             let status = self.constrained_step();
             if !matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {

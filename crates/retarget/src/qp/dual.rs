@@ -40,7 +40,7 @@ enum Con {
     Row(usize),
 }
 
-/// Problem data and workspace. Fill `h` (row-major `n × n`, symmetric; the lower triangle is
+/// Problem data and workspace. Fill `h` (row-major `n × n`, symmetric; the upper triangle is
 /// read), `c`, `lb`, `ub` (±∞ where unbounded), add general rows with [`DenseQp::add_row`],
 /// call [`DenseQp::solve`], read `x`. [`DenseQp::clear_rows`] starts the next problem's rows.
 #[derive(Debug, Clone)]
@@ -89,6 +89,10 @@ pub struct DenseQp {
     tree_l: Vec<f64>,
     tree_start: Vec<usize>,
     tree_d: Vec<f64>,
+    /// `1 / D` from the factorisation, and `D^-½` once a constraint needs it (`inv_sqrt_d`
+    /// is current when `sqrt_ready`).
+    inv_d: Vec<f64>,
+    sqrt_ready: bool,
     /// Tree mode: `J = L⁻¹ D^-½ Q` with `L⁻¹ D^-½` applied through the factor and only the
     /// orthogonal `Q` (the Givens rotations so far) stored, by columns in `jt`: column `k`
     /// is `e_k` until a rotation first touches it (`touched[k]`).
@@ -131,6 +135,8 @@ impl DenseQp {
             tree_l: Vec::new(),
             tree_start: Vec::new(),
             tree_d: vec![0.0; n],
+            inv_d: vec![0.0; n],
+            sqrt_ready: false,
             touched: vec![true; n],
             inv_sqrt_d: vec![0.0; n],
             w: vec![0.0; n],
@@ -311,7 +317,11 @@ impl DenseQp {
         let n = self.n;
         // Cholesky into `r` as scratch (row-major lower triangle), row by row.
         let l = &mut self.r;
-        l.copy_from_slice(&self.h);
+        for i in 0..n {
+            for j in 0..=i {
+                l[i * n + j] = self.h[j * n + i];
+            }
+        }
         let inv = &mut self.z; // 1 / L[j][j], scratch until the first iteration
         for i in 0..n {
             let (done, rest) = l.split_at_mut(i * n);
@@ -358,7 +368,7 @@ impl DenseQp {
         for (k, (chain, &start)) in self.chains.iter().zip(&self.tree_start).enumerate() {
             d[k] = self.h[k * n + k];
             for (v, &i) in l[start..start + chain.len()].iter_mut().zip(chain) {
-                *v = self.h[k * n + i];
+                *v = self.h[i * n + k];
             }
         }
         for k in (0..n).rev() {
@@ -383,8 +393,9 @@ impl DenseQp {
                 }
                 row_k[a] = tmp;
             }
-            self.inv_sqrt_d[k] = 1.0 / dk.sqrt();
+            self.inv_d[k] = inv;
         }
+        self.sqrt_ready = false;
         self.touched.fill(false);
         // `R` needs no clearing: only entries written since (a column's rows up to its
         // diagonal when it enters, kept so when columns move) are ever read.
@@ -412,6 +423,13 @@ impl DenseQp {
     /// Tree mode: `d = Jᵀ n_p = Qᵀ D^-½ L⁻ᵀ n_p` (`Lᵀ w = n_p` from the leaves up).
     fn tree_dual(&mut self) {
         let n = self.n;
+        if !self.sqrt_ready {
+            // Half the solves add no constraint and never need it.
+            for (s, inv) in self.inv_sqrt_d.iter_mut().zip(&self.inv_d) {
+                *s = inv.sqrt();
+            }
+            self.sqrt_ready = true;
+        }
         let mut w = std::mem::take(&mut self.w);
         w.copy_from_slice(&self.normal);
         for k in (0..n).rev() {
@@ -474,8 +492,8 @@ impl DenseQp {
                 x[i] -= lki * xk;
             }
         }
-        for (xk, dk) in x.iter_mut().zip(&self.tree_d) {
-            *xk /= dk;
+        for (xk, inv) in x.iter_mut().zip(&self.inv_d) {
+            *xk *= inv;
         }
         for k in 0..n {
             let mut xk = x[k];
@@ -936,6 +954,33 @@ mod tests {
             for i in 0..n {
                 assert!((dense.x[i] - tree.x[i]).abs() < 1e-8, "case {case}: {i}");
             }
+        }
+    }
+
+    /// Only the upper triangle of `h` is read, by the dense and the tree factorisation.
+    #[test]
+    fn the_lower_triangle_is_not_read() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(14);
+        for tree in [false, true] {
+            let n = 12;
+            let (parent, h) = random_tree_problem(&mut rng, n);
+            let mut qp = DenseQp::new(n);
+            qp.h = h;
+            qp.c = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();
+            qp.ub.fill(0.3);
+            qp.add_row(-0.2).copy_from_slice(&vec![-1.0; n]);
+            if tree {
+                qp.set_tree(&parent);
+            }
+            let mut poisoned = qp.clone();
+            for i in 0..n {
+                for j in 0..i {
+                    poisoned.h[i * n + j] = f64::NAN;
+                }
+            }
+            assert_eq!(qp.solve(), QpStatus::Optimal);
+            assert_eq!(poisoned.solve(), QpStatus::Optimal);
+            assert_eq!(qp.x, poisoned.x, "tree {tree}");
         }
     }
 
