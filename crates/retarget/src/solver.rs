@@ -580,13 +580,33 @@ impl<'m> Solver<'m> {
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
         let task = &mut self.stages[s][k];
-        for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+        let w: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r]);
+        let column = |d: usize| {
             let jp = nalgebra::Vector3::new(self.jacp[d], self.jacp[nv + d], self.jacp[2 * nv + d]);
             let jr = nalgebra::Vector3::new(self.jacr[d], self.jacr[nv + d], self.jacr[2 * nv + d]);
-            let (bp, br) = (rt * jp, rt * jr);
-            let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
-            let j = -(jlog * local);
-            *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
+            (jp, jr)
+        };
+        match self.options.arithmetic {
+            Arithmetic::Mink => {
+                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+                    let (jp, jr) = column(d);
+                    let (bp, br) = (rt * jp, rt * jr);
+                    let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
+                    let j = -(jlog * local);
+                    *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
+                }
+            }
+            Arithmetic::Lean => {
+                // Jlog = [[A, B], [0, A]]: fold the body rotation into its blocks once.
+                let a = jlog.fixed_view::<3, 3>(0, 0) * rt;
+                let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
+                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+                    let (jp, jr) = column(d);
+                    let (top, bottom) = (a * jp + b * jr, a * jr);
+                    let j = [top.x, top.y, top.z, bottom.x, bottom.y, bottom.z];
+                    *col = std::array::from_fn(|r| -(w[r] * j[r]));
+                }
+            }
         }
         let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
