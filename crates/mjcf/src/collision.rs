@@ -316,7 +316,8 @@ impl SupportMap for Placed {
 /// larger than `max_distance`, when either geom is not a primitive
 /// ([`GeomType::is_primitive`]), when an index is out of range or the pose is not finite.
 /// See the [module documentation](self) for the method; a bounding-sphere test rejects far
-/// pairs first.
+/// pairs first, and pairs for GJK a separating-axis test (the centre line, box face normals,
+/// cylinder axes), which only skips pairs GJK would find beyond `max_distance`.
 #[must_use]
 pub fn geom_distance(
     model: &Model,
@@ -335,9 +336,57 @@ pub fn geom_distance(
             let (c1, c2) = closest_points_of_segments(sa, sb);
             dilate(&a, &b, c1, c2, None)
         }
+        // Far apart along a face normal (a torso box and an arm beside it): GJK would only
+        // confirm it. The margin keeps the answer GJK's where the bound is within rounding.
+        _ if separating_axis_bound(&a, &b, max_distance + 1e-9) > max_distance + 1e-9 => {
+            return None;
+        }
         _ => support_map_distance(&a, &b, max_distance)?,
     };
     (proximity.distance <= max_distance).then_some(proximity)
+}
+
+/// Half the extent of a placed primitive along the unit direction `u` (all primitives are
+/// symmetric about their centre): `u · support(u)` from the centre, plus the radius, in
+/// closed form on `u`'s components in the geom's frame.
+#[inline]
+fn half_extent(p: &Placed, u: &Vector3<f64>) -> f64 {
+    let local = p.rot.tr_mul(u);
+    let core = match p.core {
+        Core::Point => 0.0,
+        Core::Segment(h) => h * local.z.abs(),
+        Core::Box(s) => s.x * local.x.abs() + s.y * local.y.abs() + s.z * local.z.abs(),
+        Core::Cylinder(r, h) => h * local.z.abs() + r * local.x.hypot(local.y),
+        Core::Ellipsoid(s) => s.component_mul(&local).norm(),
+    };
+    core + p.radius
+}
+
+/// A lower bound of the signed distance of two placed primitives, by separating axes: along
+/// any unit `u` their projections are at least `|u · (c₂ − c₁)| − e₁(u) − e₂(u)` apart (`e`:
+/// half extents), and so are the sets. Tried along the centre line, each box's face normals
+/// and each cylinder's axis, stopping at the first beyond `enough`. Cheap next to GJK: pairs
+/// that bounding spheres cannot reject but a face normal does (a box beside a limb) need no
+/// GJK at all.
+fn separating_axis_bound(a: &Placed, b: &Placed, enough: f64) -> f64 {
+    let centres = b.pos - a.pos;
+    let gap = |u: &Vector3<f64>| u.dot(&centres).abs() - half_extent(a, u) - half_extent(b, u);
+    let mut best = centres.try_normalize(1e-12).map_or(f64::NEG_INFINITY, |u| gap(&u));
+    for p in [a, b] {
+        let axes = match p.core {
+            Core::Box(_) => 3,
+            Core::Cylinder(..) => 1,
+            _ => 0,
+        };
+        // Columns of the rotation: the face normals; the last one is a cylinder's axis.
+        for k in (3 - axes)..3 {
+            if best > enough {
+                return best;
+            }
+            best = best.max(gap(&p.rot.column(k).into_owned()));
+        }
+    }
+    best
 }
 
 /// The closest points of two segments `(p1, q1)` and `(p2, q2)` (either may be a point):
@@ -609,6 +658,50 @@ mod tests {
         assert!(geom_distance(&m, &d, 0, 1, 0.1).is_none());
         assert!(geom_distance(&m, &d, 0, 3, 1.0).is_none());
         assert!(geom_distance(&m, &d, 0, 9, 1.0).is_none());
+    }
+
+    /// The separating-axis bound never exceeds the distance (so skipping GJK on it never
+    /// loses a pair), and it does reject pairs far apart along a face normal.
+    #[test]
+    fn separating_axis_bound_is_a_lower_bound() {
+        use rand::{Rng, SeedableRng};
+        let m = model(
+            r#"<mujoco><worldbody>
+                 <body><freejoint/><geom size="0.05"/><geom type="capsule" size="0.04 0.1"/>
+                   <geom type="box" size="0.05 0.08 0.12"/><geom type="cylinder" size="0.06 0.09"/>
+                   <geom type="ellipsoid" size="0.05 0.07 0.1"/></body>
+                 <body><freejoint/><geom size="0.05"/><geom type="capsule" size="0.04 0.1"/>
+                   <geom type="box" size="0.3 0.02 0.2"/><geom type="cylinder" size="0.06 0.09"/>
+                   <geom type="ellipsoid" size="0.05 0.07 0.1"/></body>
+               </worldbody></mujoco>"#,
+        );
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut rejected = 0;
+        for _ in 0..4000 {
+            let mut q = m.random_qpos(&mut rng);
+            for k in 0..3 {
+                q[k] = 0.0;
+                q[7 + k] = rng.gen_range(-0.4..0.4);
+            }
+            let d = at(&m, &q);
+            let (g1, g2) = (rng.gen_range(0..5), 5 + rng.gen_range(0..5));
+            let (a, b) = (Placed::new(&m, &d, g1).unwrap(), Placed::new(&m, &d, g2).unwrap());
+            let bound = separating_axis_bound(&a, &b, f64::INFINITY);
+            let exact = match support_map_distance(&a, &b, 10.0) {
+                Some(p) => p.distance,
+                None => continue,
+            };
+            let kinds = (m.geoms[g1].kind, m.geoms[g2].kind);
+            assert!(bound <= exact + 1e-9, "{kinds:?}: bound {bound} > distance {exact}");
+            let reach =
+                m.geoms[g1].bounding_radius().unwrap() + m.geoms[g2].bounding_radius().unwrap();
+            let spheres = (b.pos - a.pos).norm() - reach;
+            if spheres <= 0.03 && bound > 0.03 {
+                rejected += 1;
+                assert!(geom_distance(&m, &d, g1, g2, 0.03).is_none());
+            }
+        }
+        assert!(rejected > 100, "{rejected}");
     }
 
     #[test]

@@ -273,6 +273,26 @@ impl Model {
         }
     }
 
+    /// The columns of [`Model::jac`]'s `jacp` at `point` moving with `body` that can be
+    /// non-zero: `(dof, column)` for each dof on the body's path to the world, from the body
+    /// towards the world ([`Model::body_dofs`]), the same numbers as `jac` writes. For callers
+    /// that need a projection of the Jacobian (a constraint row `nᵀ J_p`), not all of it.
+    /// Empty when `data` is not sized for this model.
+    pub fn jac_point_columns<'a>(
+        &'a self,
+        data: &'a Data,
+        body: usize,
+        point: Vector3<f64>,
+    ) -> impl Iterator<Item = (usize, Vector3<f64>)> + 'a {
+        let sized = data.dof_axis.len() == self.nv && data.dof_linear.len() == self.nv;
+        self.body_dofs(body).take_while(move |_| sized).map(move |d| {
+            let axis = data.dof_axis[d];
+            let column =
+                if data.dof_linear[d] { axis } else { axis.cross(&(point - data.dof_anchor[d])) };
+            (d, column)
+        })
+    }
+
     /// `mj_integratePos`: `qpos ← qpos ⊕ qvel dt`. Hinge and slide add; ball and the free
     /// joint's rotation apply the quaternion exponential of the body-frame angular velocity
     /// (`mju_quatIntegrate`); the free joint's translation adds the world-frame velocity.

@@ -217,6 +217,34 @@ fn jac_of_a_point_is_the_body_jacobian_shifted() {
     }
 }
 
+/// `jac_point_columns` lists exactly `jac`'s non-zero translational columns, bit for bit.
+#[test]
+fn jac_point_columns_are_the_columns_of_jac() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/features/features.xml");
+    let model = Model::from_file(&path).unwrap();
+    let mut data = Data::new(&model);
+    model.kinematics(&model.random_qpos(&mut ChaCha8Rng::seed_from_u64(4)), &mut data);
+    let nv = model.nv;
+    let (mut jp, mut jr) = (vec![0.0; 3 * nv], vec![0.0; 3 * nv]);
+    for b in 0..model.bodies.len() {
+        let point = data.xpos[b] + Vector3::new(0.05, 0.1, -0.2);
+        model.jac(&data, b, &point, &mut jp, &mut jr);
+        let columns: Vec<(usize, Vector3<f64>)> =
+            model.jac_point_columns(&data, b, point).collect();
+        let dofs: Vec<usize> = model.body_dofs(b).collect();
+        assert_eq!(columns.iter().map(|c| c.0).collect::<Vec<_>>(), dofs);
+        for d in 0..nv {
+            let jac = Vector3::new(jp[d], jp[nv + d], jp[2 * nv + d]);
+            match columns.iter().find(|c| c.0 == d) {
+                Some((_, column)) => assert_eq!(*column, jac, "body {b} dof {d}"),
+                None => assert_eq!(jac, Vector3::zeros(), "body {b} dof {d}"),
+            }
+        }
+    }
+    let other = Data::new(&Model::from_xml_str("<mujoco><worldbody/></mujoco>", None).unwrap());
+    assert_eq!(model.jac_point_columns(&other, 1, Vector3::zeros()).count(), 0);
+}
+
 #[test]
 fn integrate_pos_follows_mujoco() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/features/features.xml");

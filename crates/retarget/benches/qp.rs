@@ -1,9 +1,10 @@
 //! The IK step's QP at our size: the G1 (nv = 35) with GMR's 14 body tasks at random
 //! configurations near the robot's home pose, its joint-range bounds, and the rows the
 //! default solve adds (the four lowest corners of each sole below the floor plane, a few
-//! self-collision-like rows). Our Goldfarb–Idnani solver ([`DenseQp`]) against `clarabel`
-//! (an interior-point solver) on the same problems; both reach the same minimiser (checked
-//! before timing). Runs without reference data.
+//! self-collision-like rows). Our Goldfarb–Idnani solver ([`DenseQp`]), with the dense
+//! factorisation and on the dof tree as the solver runs it ([`DenseQp::set_tree`]), against
+//! `clarabel` (an interior-point solver) on the same problems; all reach the same minimiser
+//! (checked before timing). Runs without reference data.
 
 use std::path::Path;
 
@@ -32,12 +33,10 @@ const BODIES: [&str; 14] = [
 
 /// `count` problems: H = Σ w² JᵀJ + λI, random c, range bounds around q, sole-corner rows
 /// whose floor sits a little above the corners (so some bind), and random sparse rows.
-fn problems(count: usize) -> Vec<DenseQp> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
+fn problems(model: &mjcf::Model, count: usize) -> Vec<DenseQp> {
     let nv = model.nv;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-    let mut data = mjcf::Data::new(&model);
+    let mut data = mjcf::Data::new(model);
     let (mut jacp, mut jacr) = (vec![0.0; 3 * nv], vec![0.0; 3 * nv]);
     let bodies: Vec<usize> = BODIES.iter().map(|b| model.body_id(b).unwrap()).collect();
     let soles: Vec<usize> =
@@ -138,15 +137,35 @@ fn clarabel_solve(qp: &DenseQp) -> Vec<f64> {
     solver.solution.x.clone()
 }
 
+/// Parent of every dof in the model's dof tree (as the solver declares it).
+fn dof_parents(model: &mjcf::Model) -> Vec<Option<usize>> {
+    let mut parent = vec![None; model.nv];
+    for body in 0..model.nbody() {
+        let chain: Vec<usize> = model.body_dofs(body).collect();
+        for pair in chain.windows(2) {
+            parent[pair[0]] = Some(pair[1]);
+        }
+    }
+    parent
+}
+
 fn bench_qp(c: &mut Criterion) {
-    let mut set = problems(200);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
+    let mut set = problems(&model, 200);
+    let mut tree_set = set.clone();
+    let parents = dof_parents(&model);
     let mut active = 0;
-    for qp in &mut set {
+    for (qp, tree) in set.iter_mut().zip(&mut tree_set) {
         assert_eq!(qp.solve(), QpStatus::Optimal);
         active += (0..qp.num_rows()).filter(|&k| qp.row_is_active(k)).count();
         let theirs = clarabel_solve(qp);
         let diff = qp.x.iter().zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(diff < 1e-5, "clarabel disagrees by {diff}");
+        tree.set_tree(&parents);
+        assert_eq!(tree.solve(), QpStatus::Optimal);
+        let diff = qp.x.iter().zip(&tree.x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(diff < 1e-8, "the tree factorisation disagrees by {diff}");
     }
     eprintln!("{} problems, {:.1} active rows each on average", set.len(), active as f64 / 200.0);
     let mut group = c.benchmark_group("qp_g1");
@@ -155,6 +174,13 @@ fn bench_qp(c: &mut Criterion) {
     group.bench_function("dense_goldfarb_idnani", |b| {
         b.iter(|| {
             for qp in set.iter_mut() {
+                std::hint::black_box(qp.solve());
+            }
+        })
+    });
+    group.bench_function("tree_goldfarb_idnani", |b| {
+        b.iter(|| {
+            for qp in tree_set.iter_mut() {
                 std::hint::black_box(qp.solve());
             }
         })

@@ -13,7 +13,7 @@
 // guarantees them in range) and row buffers are sized `nv`.
 #![allow(clippy::indexing_slicing)]
 
-use mjcf::{Data, GeomType, Model};
+use mjcf::{Data, GeomType, Model, Proximity};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::qp::DenseQp;
@@ -41,10 +41,13 @@ pub trait Constraint: std::fmt::Debug + Send {
 #[derive(Debug, Clone)]
 pub struct Ground {
     geoms: Vec<usize>,
+    /// Bounding-sphere radius per geom of `geoms`: a geom whose sphere is above the
+    /// activation height has no candidate point below it either.
+    radius: Vec<f64>,
     pub floor: f64,
     pub activation: f64,
-    jacp: Vec<f64>,
-    jacr: Vec<f64>,
+    /// Scratch: one geom's candidate points.
+    points: Vec<Vector3<f64>>,
 }
 
 impl Ground {
@@ -54,13 +57,11 @@ impl Ground {
     #[must_use]
     pub fn new(model: &Model, floor: f64) -> Ground {
         let geoms = collision_primitives(model);
-        Ground {
-            geoms,
-            floor,
-            activation: 0.1,
-            jacp: vec![0.0; 3 * model.nv],
-            jacr: vec![0.0; 3 * model.nv],
-        }
+        let radius = geoms
+            .iter()
+            .map(|&g| model.geoms[g].bounding_radius().unwrap_or(f64::INFINITY))
+            .collect();
+        Ground { geoms, radius, floor, activation: 0.1, points: Vec::with_capacity(8) }
     }
 }
 
@@ -70,17 +71,23 @@ impl Constraint for Ground {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
-        let nv = ctx.model.nv;
-        let mut points = Vec::with_capacity(8);
-        for &g in &self.geoms {
-            candidate_low_points(ctx.model, ctx.data, g, &mut points);
+        let top = self.floor + self.activation;
+        for (&g, &radius) in self.geoms.iter().zip(&self.radius) {
+            // (The margin covers the rounding of the candidate points.)
+            if ctx.data.geom_xpos[g].z - radius > top + 1e-9 {
+                continue;
+            }
+            candidate_low_points(ctx.model, ctx.data, g, &mut self.points);
             let body = ctx.model.geoms[g].body;
-            for p in &points {
-                if p.z > self.floor + self.activation {
+            for p in &self.points {
+                if p.z > top {
                     continue;
                 }
-                ctx.model.jac(ctx.data, body, p, &mut self.jacp, &mut self.jacr);
-                qp.add_row(self.floor - p.z).copy_from_slice(&self.jacp[2 * nv..3 * nv]);
+                // The z row of the point's Jacobian (zero off the body's dof chain).
+                let row = qp.add_row(self.floor - p.z);
+                for (d, column) in ctx.model.jac_point_columns(ctx.data, body, *p) {
+                    row[d] = column.z;
+                }
             }
         }
     }
@@ -138,6 +145,13 @@ pub fn collision_primitives(model: &Model) -> Vec<usize> {
 /// Nothing through itself: every pair of [`Model::self_collision_pairs`] closer than
 /// `activation` keeps its signed distance at or above `margin`, linearised at the witness
 /// points: `d + nᵀ (J₂(p₂) − J₁(p₁)) Δq ≥ margin` (`n` from geom 1 to geom 2).
+///
+/// Pairs whose bounding spheres are farther apart than `activation` are left out first.
+/// Most pairs stay so for many calls: each pair remembers by how much its spheres cleared
+/// the activation distance when last tested, and each geom how far its centre has moved
+/// since the solver started (summed over the calls); a pair is tested again only once the
+/// two centres can have moved by its clearance. The same pairs reach the distance query as
+/// when every pair is tested.
 #[derive(Debug, Clone)]
 pub struct SelfCollision {
     pairs: Vec<[usize; 2]>,
@@ -145,23 +159,30 @@ pub struct SelfCollision {
     radius: Vec<f64>,
     pub margin: f64,
     pub activation: f64,
-    jac1: Vec<f64>,
-    jac2: Vec<f64>,
-    jacr: Vec<f64>,
+    /// Per geom: its centre at the last call (none before the first) and the distance the
+    /// centre has moved over the calls so far.
+    centre: Vec<Option<Vector3<f64>>>,
+    travel: Vec<f64>,
+    /// Per pair: its spheres' clearance beyond `activation` when last tested plus both
+    /// geoms' `travel` then (−∞: test at the next call).
+    clear: Vec<f64>,
+    /// Scratch: geom 1's Jacobian columns.
+    columns: Vec<(usize, Vector3<f64>)>,
 }
 
 impl SelfCollision {
     #[must_use]
     pub fn new(model: &Model) -> SelfCollision {
-        let nv = model.nv;
+        let pairs = model.self_collision_pairs().pairs;
         SelfCollision {
-            pairs: model.self_collision_pairs().pairs,
             radius: model.geoms.iter().map(|g| g.bounding_radius().unwrap_or(0.0)).collect(),
             margin: 0.0,
             activation: 0.03,
-            jac1: vec![0.0; 3 * nv],
-            jac2: vec![0.0; 3 * nv],
-            jacr: vec![0.0; 3 * nv],
+            centre: vec![None; model.geoms.len()],
+            travel: vec![0.0; model.geoms.len()],
+            clear: vec![f64::NEG_INFINITY; pairs.len()],
+            pairs,
+            columns: Vec::with_capacity(model.nv),
         }
     }
 
@@ -169,6 +190,47 @@ impl SelfCollision {
     #[must_use]
     pub fn pairs(&self) -> &[[usize; 2]] {
         &self.pairs
+    }
+
+    /// The row of a pair in proximity `p`: `nᵀ (J₂ − J₁)` over both bodies' dof chains (zero
+    /// elsewhere).
+    fn fill_row(
+        &mut self,
+        ctx: &StepContext<'_>,
+        [g1, g2]: [usize; 2],
+        p: &Proximity,
+        row: &mut [f64],
+    ) {
+        let (model, data) = (ctx.model, ctx.data);
+        self.columns.clear();
+        self.columns.extend(model.jac_point_columns(data, model.geoms[g1].body, p.point1));
+        let mut first = self.columns.iter().peekable();
+        let mut second = model.jac_point_columns(data, model.geoms[g2].body, p.point2).peekable();
+        let zero = Vector3::zeros();
+        // Both chains run from the body towards the world (dofs descending): merge them.
+        loop {
+            let (d, j1, j2) = match (first.peek(), second.peek()) {
+                (Some(&&(d1, j1)), Some(&(d2, j2))) if d1 == d2 => {
+                    first.next();
+                    second.next();
+                    (d1, j1, j2)
+                }
+                (Some(&&(d1, j1)), Some(&(d2, _))) if d1 > d2 => {
+                    first.next();
+                    (d1, j1, zero)
+                }
+                (Some(&&(d1, j1)), None) => {
+                    first.next();
+                    (d1, j1, zero)
+                }
+                (_, Some(&(d2, j2))) => {
+                    second.next();
+                    (d2, zero, j2)
+                }
+                (None, None) => break,
+            };
+            row[d] = (0..3).map(|r| p.normal[r] * (j2[r] - j1[r])).sum();
+        }
     }
 }
 
@@ -178,24 +240,35 @@ impl Constraint for SelfCollision {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
+        // Below this clearance a pair is tested exactly (rounding of the bound).
+        const SLACK: f64 = 1e-9;
         let (model, data) = (ctx.model, ctx.data);
-        let nv = model.nv;
-        for &[g1, g2] in &self.pairs {
-            let reach = self.radius[g1] + self.radius[g2] + self.activation;
-            if (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared() > reach * reach {
+        for ((centre, travel), now) in
+            self.centre.iter_mut().zip(&mut self.travel).zip(&data.geom_xpos)
+        {
+            if let Some(seen) = centre {
+                *travel += (now - *seen).norm();
+            }
+            *centre = Some(*now);
+        }
+        for k in 0..self.pairs.len() {
+            let [g1, g2] = self.pairs[k];
+            let moved = self.travel[g1] + self.travel[g2];
+            if self.clear[k] - moved > SLACK {
                 continue;
             }
+            let reach = self.radius[g1] + self.radius[g2] + self.activation;
+            let apart = (data.geom_xpos[g1] - data.geom_xpos[g2]).norm_squared();
+            if apart > reach * reach {
+                self.clear[k] = apart.sqrt() - reach + moved;
+                continue;
+            }
+            self.clear[k] = f64::NEG_INFINITY;
             let Some(p) = mjcf::geom_distance(model, data, g1, g2, self.activation) else {
                 continue;
             };
-            model.jac(data, model.geoms[g1].body, &p.point1, &mut self.jac1, &mut self.jacr);
-            model.jac(data, model.geoms[g2].body, &p.point2, &mut self.jac2, &mut self.jacr);
             let row = qp.add_row(self.margin - p.distance);
-            for (d, a) in row.iter_mut().enumerate() {
-                *a = (0..3)
-                    .map(|r| p.normal[r] * (self.jac2[r * nv + d] - self.jac1[r * nv + d]))
-                    .sum();
-            }
+            self.fill_row(ctx, [g1, g2], &p, row);
         }
     }
 }

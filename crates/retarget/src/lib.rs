@@ -102,4 +102,4 @@ pub use pipeline::{
 };
 pub use retargeter::{FileResult, HumanFrame, Retargeter};
 pub use robot_roles::{RobotRole, RobotRoles, Sole};
-pub use solver::{FrameDiagnostics, Solver, SolverOptions, TaskSpec};
+pub use solver::{Arithmetic, FrameDiagnostics, Solver, SolverOptions, TaskSpec};

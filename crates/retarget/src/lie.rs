@@ -145,11 +145,16 @@ pub fn rminus(a: &Pose, b: &Pose) -> Vector6<f64> {
 #[must_use]
 pub fn so3_ljacinv(omega: &Vector3<f64>) -> Matrix3<f64> {
     let theta = omega.norm();
+    so3_ljacinv_with(omega, theta, theta.sin_cos())
+}
+
+/// [`so3_ljacinv`] given `θ = |ω|` and `(sin θ, cos θ)`.
+fn so3_ljacinv_with(omega: &Vector3<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
     let t2 = theta * theta;
     let beta = if theta < EPS {
         (1.0 / 12.0) * (1.0 + t2 / 60.0 * (1.0 + t2 / 42.0 * (1.0 + t2 / 40.0)))
     } else {
-        (1.0 / t2) * (1.0 - (theta * theta.sin() / (2.0 * (1.0 - theta.cos()))))
+        (1.0 / t2) * (1.0 - (theta * st / (2.0 * (1.0 - ct))))
     };
     let inner = omega.dot(omega);
     let mut out = Matrix3::zeros();
@@ -171,18 +176,17 @@ pub fn so3_ljacinv(omega: &Vector3<f64>) -> Matrix3<f64> {
     out
 }
 
-/// The Q block of the SE(3) left Jacobian (eq. 180), `c = [v; ω]`.
-fn q_block(c: &Vector6<f64>) -> Matrix3<f64> {
+/// The Q block of the SE(3) left Jacobian (eq. 180), `c = [v; ω]`, given `θ = |ω|` and
+/// `(sin θ, cos θ)`.
+fn q_block(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
     let v = Vector3::new(c[0], c[1], c[2]);
     let w = Vector3::new(c[3], c[4], c[5]);
-    let theta = w.norm();
     let t2 = theta * theta;
     let a = 0.5;
     let (b, cc, d) = if t2 < EPS {
         (1.0 / 6.0 + (1.0 / 120.0) * t2, -(1.0 / 24.0) + (1.0 / 720.0) * t2, -(1.0 / 60.0))
     } else {
         let t4 = t2 * t2;
-        let (st, ct) = (theta.sin(), theta.cos());
         (
             (theta - st) / (t2 * theta),
             (1.0 - 0.5 * t2 - ct) / t4,
@@ -210,13 +214,23 @@ fn q_block(c: &Vector6<f64>) -> Matrix3<f64> {
 /// `rjacinv(τ) = ljacinv(−τ)` (eq. 179b).
 #[must_use]
 pub fn se3_jlog(p: &Pose) -> Matrix6<f64> {
-    let neg = -se3_log(p);
+    se3_jlog_at(&-se3_log(p))
+}
+
+/// [`se3_jlog`] from `neg = −log(p)` (`= log(p⁻¹)`), for a caller that has that logarithm
+/// already: `ljacinv(neg)`.
+#[must_use]
+pub fn se3_jlog_at(neg: &Vector6<f64>) -> Matrix6<f64> {
+    let neg = *neg;
     let w = Vector3::new(neg[3], neg[4], neg[5]);
     if w.dot(&w) < EPS {
         return Matrix6::identity();
     }
-    let q = q_block(&neg);
-    let lji = so3_ljacinv(&w);
+    // One sine and cosine for both blocks (each computed them from the same θ).
+    let theta = w.norm();
+    let sc = theta.sin_cos();
+    let q = q_block(&neg, theta, sc);
+    let lji = so3_ljacinv_with(&w, theta, sc);
     let jqj = lji * (q * lji);
     let mut out = Matrix6::zeros();
     out.fixed_view_mut::<3, 3>(0, 0).copy_from(&lji);

@@ -512,6 +512,7 @@ pub(crate) fn build_solver<'m>(
     let mut solver_options = options.solver.clone();
     if let SolveMode::Plausible(p) = &options.mode {
         solver_options.max_extra_steps = p.max_extra_steps;
+        solver_options.arithmetic = crate::solver::Arithmetic::Lean;
     }
     let mut solver = Solver::new(model, stages, solver_options)?;
     if let SolveMode::Plausible(p) = &options.mode {

@@ -23,6 +23,8 @@
 // dof and qpos addresses) are in range by `mjcf::Model`'s construction.
 #![allow(clippy::indexing_slicing)]
 
+use std::ops::AddAssign;
+
 use mjcf::{Data, JointType, Model};
 
 use crate::constraints::{Constraint, StepContext};
@@ -50,6 +52,22 @@ pub struct SolverOptions {
     /// (GMR constructs a velocity limit but mink 1.3.0 ignores it, see `solve_ik`'s
     /// positional arguments). When set, `|q − q_previous frame| ≤ max_joint_speed · dt`.
     pub max_joint_speed: Option<f64>,
+    /// Whether the task terms follow mink operation by operation (GMR) or take shortcuts
+    /// that are equal to rounding.
+    pub arithmetic: Arithmetic,
+}
+
+/// How closely the solver follows mink's arithmetic ([`SolverOptions::arithmetic`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Arithmetic {
+    /// Operation by operation as mink: GMR's numbers, bit for bit (`--gmr`).
+    #[default]
+    Mink,
+    /// The same quantities in fewer operations, equal to rounding: a task's `Jlog` from the
+    /// error computed just before (`e = log(T_b⁻¹ T_t) = −log(T_t⁻¹ T_b)`, one SE(3)
+    /// logarithm per task and step fewer), body orientations from the kinematics'
+    /// quaternions instead of read back from the rotation matrices.
+    Lean,
 }
 
 impl Default for SolverOptions {
@@ -61,6 +79,7 @@ impl Default for SolverOptions {
             max_extra_steps: 10,
             limit_gain: 0.95,
             max_joint_speed: None,
+            arithmetic: Arithmetic::Mink,
         }
     }
 }
@@ -121,8 +140,9 @@ struct TaskWork {
     scale: [f64; 6],
     /// Dofs moving the body (its Jacobian's non-zero columns), ascending.
     dofs: Vec<usize>,
-    /// Error at the current configuration.
+    /// Error at the current configuration, and the body's pose it was computed from.
     err: nalgebra::Vector6<f64>,
+    frame: Pose,
     /// Weighted Jacobian, one 6-column per dof of `dofs`.
     wjac: Vec<[f64; 6]>,
 }
@@ -159,15 +179,12 @@ pub struct Solver<'m> {
     dense: DenseQp,
     /// Dofs moving each body, ascending.
     body_dofs: Vec<Vec<usize>>,
-    /// Scratch: a point task's Jacobian columns, plain and weighted.
-    point_cols: Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)>,
+    /// Scratch: a body's Jacobian columns `J₆` and `M J₆` ([`Solver::add_point_tasks`]).
+    point_cols: Vec<(nalgebra::Vector6<f64>, nalgebra::Vector6<f64>)>,
     /// Whether the constraints are held ([`Solver::hold_constraints`]).
     constraints_on: bool,
     /// This frame's point tasks ([`Solver::set_point_tasks`]).
     point_tasks: Vec<PointTask>,
-    /// Whether a general row was active in the last dense solve (then the next step goes
-    /// straight to the dense solver).
-    rows_bound: bool,
     /// The constraints' rows are linearised once per frame (and pass), at the first
     /// constrained step; later steps of the frame re-centre them on the configuration
     /// reached (`moved`: the sum of the steps since, tangent space). Whether they are made,
@@ -213,6 +230,7 @@ impl<'m> Solver<'m> {
                     wjac: vec![[0.0; 6]; dofs.len()],
                     dofs,
                     err: nalgebra::Vector6::zeros(),
+                    frame: Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: nalgebra::Vector3::zeros() },
                 });
             }
             works.push(tasks);
@@ -226,8 +244,11 @@ impl<'m> Solver<'m> {
                 j.range.map(|range| Limit { joint: i, dof: j.dof_adr, qpos: j.qpos_adr, range })
             })
             .collect();
+        let parents = dof_parents(model);
         let mut qp = BoxQp::new(nv);
-        qp.set_tree(dof_parents(model));
+        qp.set_tree(parents.clone());
+        let mut dense = DenseQp::new(nv);
+        dense.set_tree(&parents);
         let mut solver = Solver {
             model,
             options,
@@ -244,7 +265,7 @@ impl<'m> Solver<'m> {
             qp_failures: 0,
             constraints: Vec::new(),
             dof_speed: vec![None; nv],
-            dense: DenseQp::new(nv),
+            dense,
             point_tasks: Vec::new(),
             body_dofs: (0..model.nbody())
                 .map(|b| {
@@ -255,7 +276,6 @@ impl<'m> Solver<'m> {
                 .collect(),
             point_cols: Vec::with_capacity(nv),
             constraints_on: true,
-            rows_bound: false,
             rows_made: false,
             row_base: Vec::new(),
             row_ends: Vec::new(),
@@ -391,9 +411,17 @@ impl<'m> Solver<'m> {
         (steps, next)
     }
 
-    /// Frame pose as mink reads it: quaternion from `xmat`, position `xpos`.
+    /// Frame pose as mink reads it (quaternion from `xmat`), or the kinematics' own
+    /// quaternion ([`Arithmetic::Lean`]); position `xpos`.
     fn body_pose(&self, body: usize) -> Pose {
-        Pose { quat: lie::mat_to_quat(&self.data.xmat[body]), pos: self.data.xpos[body] }
+        let quat = match self.options.arithmetic {
+            Arithmetic::Mink => lie::mat_to_quat(&self.data.xmat[body]),
+            Arithmetic::Lean => {
+                let q = self.data.xquat[body];
+                [q.w, q.i, q.j, q.k]
+            }
+        };
+        Pose { quat, pos: self.data.xpos[body] }
     }
 
     /// Updates every task's error at the current configuration; returns the norm of all.
@@ -404,7 +432,7 @@ impl<'m> Solver<'m> {
             let frame = self.body_pose(spec.body);
             let e = lie::rminus(&targets[spec.target], &frame);
             sum += e.norm_squared();
-            self.stages[s][k].err = e;
+            (self.stages[s][k].err, self.stages[s][k].frame) = (e, frame);
         }
         sum.sqrt()
     }
@@ -418,9 +446,10 @@ impl<'m> Solver<'m> {
             mu_total += self.task_objective(s, k, targets);
         }
         self.add_point_tasks();
-        self.finish_hessian(self.options.damping + mu_total);
+        self.add_diagonal(self.options.damping + mu_total);
         self.set_bounds(dt);
         let status = if self.constraints.is_empty() || !self.constraints_on {
+            self.mirror_hessian();
             let status = self.qp.solve();
             self.dq.copy_from_slice(&self.qp.x);
             status
@@ -436,11 +465,19 @@ impl<'m> Solver<'m> {
         self.take_step();
     }
 
-    /// Adds `diagonal` to H's diagonal and mirrors its upper triangle into the lower one.
-    fn finish_hessian(&mut self, diagonal: f64) {
+    /// Adds `diagonal` to H's diagonal.
+    fn add_diagonal(&mut self, diagonal: f64) {
         let nv = self.model.nv;
         for d in 0..nv {
             self.qp.h[d * nv + d] += diagonal;
+        }
+    }
+
+    /// Mirrors H's upper triangle (where the terms are added) into the lower one, for the
+    /// box solver, which reads whole rows ([`DenseQp`] reads the upper triangle).
+    fn mirror_hessian(&mut self) {
+        let nv = self.model.nv;
+        for d in 0..nv {
             for e in 0..d {
                 self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
             }
@@ -454,11 +491,12 @@ impl<'m> Solver<'m> {
         self.model.kinematics(&self.qpos, &mut self.data);
     }
 
-    /// The step under the general constraints, H, c and the bounds already in `self.qp`.
-    /// The box-only optimum is tried first: when it satisfies every row it is the optimum
-    /// of the constrained problem too. Otherwise the dense dual solver takes all of it; if
-    /// the constraints cannot hold together, the lowest-priority ones are relaxed in turn:
-    /// later constraints first, then the speed limits (see [`Solver::add_constraint`]).
+    /// The step under the general constraints, H, c and the bounds already in `self.qp`,
+    /// solved by the dual active-set solver on the dof tree's factorisation (bounds and rows
+    /// alike: a bound entering the active set is a few `O(n)` updates, where the primal box
+    /// solver refactorises). If the constraints cannot hold together, the lowest-priority
+    /// ones are relaxed in turn: later constraints first, then the speed limits (see
+    /// [`Solver::add_constraint`]).
     fn constrained_step(&mut self) -> QpStatus {
         // Beyond this (rad or m, any coordinate) from where they were made, the rows are made
         // again. Held over any move, the linearisation took Fourier N1's walk from 8.9 to
@@ -487,25 +525,18 @@ impl<'m> Solver<'m> {
 
     /// [`Solver::constrained_step`] once the rows are in `self.dense`.
     fn constrained_solve(&mut self, ends: &[usize]) -> QpStatus {
-        // The box-only solve is cheaper; skip it while the rows keep binding.
-        if !self.rows_bound {
-            let status = self.qp.solve();
-            if status == QpStatus::Optimal && self.dense.rows_hold(&self.qp.x) {
-                self.dq.copy_from_slice(&self.qp.x);
-                return status;
-            }
-        }
-        self.dense.h.copy_from_slice(&self.qp.h);
-        self.dense.c.copy_from_slice(&self.qp.c);
-        self.dense.lb.copy_from_slice(&self.qp.lb);
-        self.dense.ub.copy_from_slice(&self.qp.ub);
+        // Hand the objective and bounds over without copying: every step rebuilds all four
+        // in `self.qp` (H and c from zero, the bounds from ±∞), whatever they held.
+        std::mem::swap(&mut self.dense.h, &mut self.qp.h);
+        std::mem::swap(&mut self.dense.c, &mut self.qp.c);
+        std::mem::swap(&mut self.dense.lb, &mut self.qp.lb);
+        std::mem::swap(&mut self.dense.ub, &mut self.qp.ub);
         let mut status = self.dense.solve();
         if status == QpStatus::Infeasible {
             self.relaxed_steps += 1;
             status = self.relax(ends);
         }
         self.dq.copy_from_slice(&self.dense.x);
-        self.rows_bound = (0..self.dense.num_rows()).any(|k| self.dense.row_is_active(k));
         status
     }
 
@@ -539,22 +570,47 @@ impl<'m> Solver<'m> {
         let nv = self.model.nv;
         let task = &self.stages[s][k];
         let body = task.spec.body;
-        let frame = self.body_pose(body);
-        let jlog = lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &frame));
+        // The pose and error `stage_error` found at this configuration (every step follows one).
+        let jlog = match self.options.arithmetic {
+            Arithmetic::Mink => {
+                lie::se3_jlog(&lie::inverse_multiply(&targets[task.spec.target], &task.frame))
+            }
+            Arithmetic::Lean => lie::se3_jlog_at(&task.err),
+        };
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let rt = self.data.xmat[body].transpose();
         let task = &mut self.stages[s][k];
-        for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+        let w: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r]);
+        let column = |d: usize| {
             let jp = nalgebra::Vector3::new(self.jacp[d], self.jacp[nv + d], self.jacp[2 * nv + d]);
             let jr = nalgebra::Vector3::new(self.jacr[d], self.jacr[nv + d], self.jacr[2 * nv + d]);
-            let (bp, br) = (rt * jp, rt * jr);
-            let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
-            let j = -(jlog * local);
-            *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
+            (jp, jr)
+        };
+        match self.options.arithmetic {
+            Arithmetic::Mink => {
+                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+                    let (jp, jr) = column(d);
+                    let (bp, br) = (rt * jp, rt * jr);
+                    let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
+                    let j = -(jlog * local);
+                    *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
+                }
+            }
+            Arithmetic::Lean => {
+                // Jlog = [[A, B], [0, A]]: fold the body rotation into its blocks once.
+                let a = jlog.fixed_view::<3, 3>(0, 0) * rt;
+                let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
+                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
+                    let (jp, jr) = column(d);
+                    let (top, bottom) = (a * jp + b * jr, a * jr);
+                    let j = [top.x, top.y, top.z, bottom.x, bottom.y, bottom.z];
+                    *col = std::array::from_fn(|r| -(w[r] * j[r]));
+                }
+            }
         }
         let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
-        // Upper triangle only (dofs ascending); `step` mirrors it.
+        // Upper triangle only (dofs ascending); mirrored for the box solver.
         for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
             self.qp.c[da] -= dot6(&we, col_a);
             let row = &mut self.qp.h[da * nv..(da + 1) * nv];
@@ -567,34 +623,59 @@ impl<'m> Solver<'m> {
 
     /// `w² JᵀJ` into H and `−w² Jᵀ e` into c for each point task (`J`: the point's
     /// translational Jacobian, `e = target − p`).
-    /// Upper triangle only (dofs ascending; the caller mirrors H). Points on one body share
-    /// its Jacobian at the origin: a point `r` away moves by `J_p = J_o + J_ω × r`.
+    /// Upper triangle only (dofs ascending). Points on one body share
+    /// its Jacobian at the origin, `J_o` and `J_ω`: a point `r` away moves by
+    /// `J_o − [r]× J_ω = A J₆` (`A = [I, −[r]×]`, `J₆ = [J_o; J_ω]`), so the body's points
+    /// add `J₆ᵀ M J₆` with `M = Σ Aᵀ W A` (6 × 6) and `−J₆ᵀ Σ Aᵀ W e`: one pass over the
+    /// body's dof pairs whatever the number of points.
     fn add_point_tasks(&mut self) {
         let nv = self.model.nv;
         let mut k = 0;
         while k < self.point_tasks.len() {
             let b = self.point_tasks[k].body;
             self.model.jac_chain(&self.data, b, &mut self.jacp, &mut self.jacr);
-            let dofs = &self.body_dofs[b];
-            let origin = self.data.xpos[b];
+            let (origin, rotation) = (self.data.xpos[b], self.data.xmat[b]);
+            let mut m = nalgebra::Matrix6::<f64>::zeros();
+            let mut g = nalgebra::Vector6::<f64>::zeros();
             while let Some(task) = self.point_tasks.get(k).filter(|t| t.body == b) {
-                let r = self.data.xmat[b] * task.point;
+                let r = rotation * task.point;
                 let e = task.target - (origin + r);
-                let w2 = task.weight.component_mul(&task.weight);
-                self.point_cols.clear();
-                for &d in dofs {
-                    let col = |j: &[f64]| nalgebra::Vector3::new(j[d], j[nv + d], j[2 * nv + d]);
-                    let j = col(&self.jacp) + col(&self.jacr).cross(&r);
-                    self.point_cols.push((j, j.component_mul(&w2)));
-                }
-                for (a, (&da, (_, wa))) in dofs.iter().zip(&self.point_cols).enumerate() {
-                    self.qp.c[da] -= wa.dot(&e);
-                    let row = &mut self.qp.h[da * nv..(da + 1) * nv];
-                    for (&db, (jb, _)) in dofs[a..].iter().zip(&self.point_cols[a..]) {
-                        row[db] += wa.dot(jb);
-                    }
-                }
+                let w = nalgebra::Matrix3::from_diagonal(&task.weight.component_mul(&task.weight));
+                let s = r.cross_matrix();
+                let ws = w * s;
+                // Aᵀ W A = [[W, −W S], [−Sᵀ W, Sᵀ W S]], Aᵀ W e = [W e; −Sᵀ W e] (S = [r]×).
+                let mut block = |row: usize, col: usize, v: &nalgebra::Matrix3<f64>| {
+                    let mut view = m.fixed_view_mut::<3, 3>(row, col);
+                    view += v;
+                };
+                block(0, 0, &w);
+                block(0, 3, &-ws);
+                block(3, 0, &-ws.transpose());
+                block(3, 3, &(s.transpose() * ws));
+                let we = w * e;
+                g.fixed_rows_mut::<3>(0).add_assign(&we);
+                g.fixed_rows_mut::<3>(3).add_assign(&r.cross(&we));
                 k += 1;
+            }
+            let dofs = &self.body_dofs[b];
+            self.point_cols.clear();
+            for &d in dofs {
+                let j = nalgebra::Vector6::new(
+                    self.jacp[d],
+                    self.jacp[nv + d],
+                    self.jacp[2 * nv + d],
+                    self.jacr[d],
+                    self.jacr[nv + d],
+                    self.jacr[2 * nv + d],
+                );
+                self.point_cols.push((j, m * j));
+            }
+            for (a, (&da, (ja, _))) in dofs.iter().zip(&self.point_cols).enumerate() {
+                self.qp.c[da] -= ja.dot(&g);
+                let row = &mut self.qp.h[da * nv..(da + 1) * nv];
+                for (&db, (_, mb)) in dofs[a..].iter().zip(&self.point_cols[a..]) {
+                    row[db] += ja.dot(mb);
+                }
             }
         }
     }
@@ -664,7 +745,7 @@ impl<'m> Solver<'m> {
 
             self.add_posture(reference, weight);
             self.add_point_tasks();
-            self.finish_hessian(self.options.damping);
+            self.add_diagonal(self.options.damping);
             self.set_bounds(dt);
             let status = self.constrained_step();
             if !matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
