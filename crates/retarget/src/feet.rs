@@ -60,8 +60,9 @@ pub struct FootPlanOptions {
     /// in stance (the foot tasks' position weights are 50 in GMR's configs).
     pub contact_weight: f64,
     /// Least horizontal gap (m) between the two soles when both are planted at once: anchors
-    /// closer than this are moved apart ([`separate`]), so that the planted feet do not ask
-    /// for the soles inside each other, which the self-collision constraint then fights.
+    /// closer than this are moved apart, half the shortfall each, along the footprints'
+    /// separating axis, so that the planted feet do not ask for the soles inside each other,
+    /// which the self-collision constraint then fights.
     pub sole_gap: f64,
 }
 
