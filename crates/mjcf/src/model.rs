@@ -204,6 +204,14 @@ impl Model {
         self.bodies.len()
     }
 
+    /// Per dof, the previous dof on its path to the world (MuJoCo `dof_parentid`; `None` for
+    /// the first dof of a tree): the dof tree that sparse factorisations of the mass-like
+    /// matrices follow.
+    #[must_use]
+    pub fn dof_parents(&self) -> &[Option<usize>] {
+        &self.dof_parent
+    }
+
     /// The dofs that move `body` (MuJoCo's dof ancestor chain), from the body towards the world.
     pub fn body_dofs(&self, body: usize) -> impl Iterator<Item = usize> + '_ {
         let start = self.body_last_dof.get(body).copied().flatten();

@@ -137,24 +137,12 @@ fn clarabel_solve(qp: &DenseQp) -> Vec<f64> {
     solver.solution.x.clone()
 }
 
-/// Parent of every dof in the model's dof tree (as the solver declares it).
-fn dof_parents(model: &mjcf::Model) -> Vec<Option<usize>> {
-    let mut parent = vec![None; model.nv];
-    for body in 0..model.nbody() {
-        let chain: Vec<usize> = model.body_dofs(body).collect();
-        for pair in chain.windows(2) {
-            parent[pair[0]] = Some(pair[1]);
-        }
-    }
-    parent
-}
-
 fn bench_qp(c: &mut Criterion) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
     let mut set = problems(&model, 200);
     let mut tree_set = set.clone();
-    let parents = dof_parents(&model);
+    let parents = model.dof_parents().to_vec();
     let mut active = 0;
     for (qp, tree) in set.iter_mut().zip(&mut tree_set) {
         assert_eq!(qp.solve(), QpStatus::Optimal);

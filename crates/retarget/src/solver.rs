@@ -244,7 +244,7 @@ impl<'m> Solver<'m> {
                 j.range.map(|range| Limit { joint: i, dof: j.dof_adr, qpos: j.qpos_adr, range })
             })
             .collect();
-        let parents = dof_parents(model);
+        let parents = model.dof_parents().to_vec();
         let mut qp = BoxQp::new(nv);
         qp.set_tree(parents.clone());
         let mut dense = DenseQp::new(nv);
@@ -852,18 +852,6 @@ impl<'m> Solver<'m> {
             .map(|l| l.joint)
             .collect()
     }
-}
-
-/// Parent of every dof in MuJoCo's dof tree, from the bodies' dof chains.
-fn dof_parents(model: &Model) -> Vec<Option<usize>> {
-    let mut parent = vec![None; model.nv];
-    for body in 0..model.nbody() {
-        let chain: Vec<usize> = model.body_dofs(body).collect();
-        for pair in chain.windows(2) {
-            parent[pair[0]] = Some(pair[1]);
-        }
-    }
-    parent
 }
 
 fn check_options(o: &SolverOptions) -> Result<(), Error> {
