@@ -276,12 +276,7 @@ fn human_motion(frames: &Bound<'_, PyAny>, fps: f64) -> PyResult<fk::HumanMotion
             human.body_names.clone_from(&frame.body_names);
         }
         for name in &human.body_names {
-            let found = frame
-                .body_names
-                .iter()
-                .position(|n| n == name)
-                .and_then(|i| Some((frame.positions.get(i)?, frame.orientations.get(i)?)));
-            let (position, orientation) = found.ok_or_else(|| {
+            let (position, orientation) = frame.pose(name).ok_or_else(|| {
                 PyValueError::new_err(format!("frame {}: no body {name:?}", human.num_frames))
             })?;
             human.positions.push(*position);

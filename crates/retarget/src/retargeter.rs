@@ -54,6 +54,14 @@ pub struct HumanFrame {
 }
 
 impl HumanFrame {
+    /// The position and orientation of body `name` (`None` when the frame has no such body,
+    /// or no pose for it).
+    #[must_use]
+    pub fn pose(&self, name: &str) -> Option<(&Vector3<f64>, &UnitQuaternion<f64>)> {
+        let i = self.body_names.iter().position(|n| n == name)?;
+        Some((self.positions.get(i)?, self.orientations.get(i)?))
+    }
+
     /// Frame `frame` of a clip (`None` past its end).
     #[must_use]
     pub fn from_motion(human: &HumanMotion, frame: usize) -> Option<HumanFrame> {
@@ -607,12 +615,7 @@ impl Stream {
         self.positions.clear();
         self.orientations.clear();
         for name in &self.names {
-            let found = frame
-                .body_names
-                .iter()
-                .position(|n| n == name)
-                .and_then(|i| Some((frame.positions.get(i)?, frame.orientations.get(i)?)));
-            let Some((position, orientation)) = found else {
+            let Some((position, orientation)) = frame.pose(name) else {
                 return Err(Error::InvalidOption(format!(
                     "frame {}: body `{name}` of the first frame is missing",
                     self.frames
