@@ -486,26 +486,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         for case in 0..200 {
             let n = rng.gen_range(1..25);
-            let parent: Vec<Option<usize>> = (0..n)
-                .map(
-                    |i| if i == 0 || rng.gen_bool(0.15) { None } else { Some(rng.gen_range(0..i)) },
-                )
-                .collect();
-            let mut h = vec![0.0; n * n];
-            for leaf in 0..n {
-                let chain: Vec<usize> = std::iter::successors(Some(leaf), |&d| parent[d]).collect();
-                for _ in 0..3 {
-                    let row: Vec<f64> = chain.iter().map(|_| rng.gen_range(-1.0..1.0)).collect();
-                    for (a, &i) in chain.iter().enumerate() {
-                        for (b, &j) in chain.iter().enumerate() {
-                            h[i * n + j] += row[a] * row[b];
-                        }
-                    }
-                }
-            }
-            for i in 0..n {
-                h[i * n + i] += 0.1;
-            }
+            let (parent, h) = crate::qp::random_tree_problem(&mut rng, n, 0.1);
             let mut dense = BoxQp::new(n);
             dense.h = h;
             dense.c = (0..n).map(|_| rng.gen_range(-3.0..3.0)).collect();

@@ -889,30 +889,6 @@ mod tests {
         }
     }
 
-    /// A random tree over `n` dofs (parents before children, several roots) and an `H`
-    /// with its sparsity: a sum of outer products of rows along root-to-leaf chains.
-    fn random_tree_problem(rng: &mut impl Rng, n: usize) -> (Vec<Option<usize>>, Vec<f64>) {
-        let parent: Vec<Option<usize>> = (0..n)
-            .map(|i| if i == 0 || rng.gen_bool(0.15) { None } else { Some(rng.gen_range(0..i)) })
-            .collect();
-        let mut h = vec![0.0; n * n];
-        for leaf in 0..n {
-            let chain: Vec<usize> = std::iter::successors(Some(leaf), |&d| parent[d]).collect();
-            for _ in 0..3 {
-                let row: Vec<f64> = chain.iter().map(|_| rng.gen_range(-1.0..1.0)).collect();
-                for (a, &i) in chain.iter().enumerate() {
-                    for (b, &j) in chain.iter().enumerate() {
-                        h[i * n + j] += row[a] * row[b];
-                    }
-                }
-            }
-        }
-        for i in 0..n {
-            h[i * n + i] += 0.05;
-        }
-        (parent, h)
-    }
-
     /// The tree factorisation (and its sparse Givens updates) reaches the dense path's
     /// minimiser, and KKT holds, with bounds and rows binding.
     #[test]
@@ -920,7 +896,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
         for case in 0..300 {
             let n = rng.gen_range(1..30);
-            let (parent, h) = random_tree_problem(&mut rng, n);
+            let (parent, h) = crate::qp::random_tree_problem(&mut rng, n, 0.05);
             let mut dense = DenseQp::new(n);
             dense.h = h;
             dense.c = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();
@@ -963,7 +939,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(14);
         for tree in [false, true] {
             let n = 12;
-            let (parent, h) = random_tree_problem(&mut rng, n);
+            let (parent, h) = crate::qp::random_tree_problem(&mut rng, n, 0.05);
             let mut qp = DenseQp::new(n);
             qp.h = h;
             qp.c = (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect();

@@ -13,3 +13,34 @@ mod dual;
 
 pub use boxed::{BoxQp, QpStatus};
 pub use dual::DenseQp;
+
+/// A random tree over `n` dofs (parents before children, several roots) and an `H` with its
+/// sparsity: a sum of outer products of rows along root-to-leaf chains, plus `ridge` on the
+/// diagonal. Test problems of both solvers' tree factorisations.
+#[cfg(test)]
+#[allow(clippy::indexing_slicing)]
+pub(crate) fn random_tree_problem(
+    rng: &mut impl rand::Rng,
+    n: usize,
+    ridge: f64,
+) -> (Vec<Option<usize>>, Vec<f64>) {
+    let parent: Vec<Option<usize>> = (0..n)
+        .map(|i| if i == 0 || rng.gen_bool(0.15) { None } else { Some(rng.gen_range(0..i)) })
+        .collect();
+    let mut h = vec![0.0; n * n];
+    for leaf in 0..n {
+        let chain: Vec<usize> = std::iter::successors(Some(leaf), |&d| parent[d]).collect();
+        for _ in 0..3 {
+            let row: Vec<f64> = chain.iter().map(|_| rng.gen_range(-1.0..1.0)).collect();
+            for (a, &i) in chain.iter().enumerate() {
+                for (b, &j) in chain.iter().enumerate() {
+                    h[i * n + j] += row[a] * row[b];
+                }
+            }
+        }
+    }
+    for i in 0..n {
+        h[i * n + i] += ridge;
+    }
+    (parent, h)
+}
