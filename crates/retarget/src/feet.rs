@@ -14,6 +14,13 @@
 //! 3. **Blending**: for [`FootPlanOptions::blend_s`] before touch-down and after lift-off the
 //!    target moves linearly (slerp for orientations) between the planted pose and the free
 //!    one, and so does the weight, so the foot neither jumps onto its anchor nor off it.
+//! 4. **Swing clearance**: out of stance the target's sole stays at least
+//!    [`FootPlanOptions::swing_clearance`] above the floor. It rises to that height over
+//!    [`FootPlanOptions::lift_s`] after lift-off and comes down from it over the same time
+//!    before touch-down. While it rises or comes down it is held over its anchor, so it lifts
+//!    off before it moves and moves before it comes down. A foot is then either on the
+//!    floor and still, or clear of it. Without this, the swing foot skims the floor at the
+//!    start and end of every step, a few millimetres up and moving at a few dm/s.
 //!
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body.
@@ -64,6 +71,12 @@ pub struct FootPlanOptions {
     /// separating axis, so that the planted feet do not ask for the soles inside each other,
     /// which the self-collision constraint then fights.
     pub sole_gap: f64,
+    /// Least height (m) of the sole's lowest point above the floor out of stance, once the
+    /// foot has risen ([`FootPlanOptions::lift_s`]).
+    pub swing_clearance: f64,
+    /// Time (s) over which the swing clearance fades in after lift-off and out before
+    /// touch-down (smoothstep).
+    pub lift_s: f64,
 }
 
 impl Default for FootPlanOptions {
@@ -76,6 +89,8 @@ impl Default for FootPlanOptions {
             clearance: 0.002,
             contact_weight: 400.0,
             sole_gap: 0.03,
+            swing_clearance: 0.032,
+            lift_s: 1.0 / 30.0,
         }
     }
 }
@@ -371,19 +386,74 @@ pub fn plan(
                 }
             }
         }
+        let edges = swing_edges(&planted);
         for t in 0..frames {
             if planted[t] {
                 weight[t][side] = options.stance_weight;
-            } else if ramp[t].weight > 0.0 {
-                let pose = ramp[t].apply(&free[t]);
-                let w = ramp[t].weight.min(1.0);
-                contact[t][side] = foot.contact_points(&pose, w);
+                continue;
+            }
+            let (mut pose, w) = if ramp[t].weight > 0.0 {
+                (ramp[t].apply(&free[t]), ramp[t].weight.min(1.0))
+            } else {
+                (free[t], 0.0)
+            };
+            let mut changed = w > 0.0;
+            if let Some((edge, frames_off)) = edges[t] {
+                // (The tolerance: at 30 fps and 1/30 s, one frame is all the way up.)
+                let rise = smoothstep((frames_off as f64 / (options.lift_s * fps) + 1e-9).min(1.0));
+                if rise < 1.0 {
+                    // Still rising (or already coming down): over the anchor, rolled as the
+                    // free target is tilted.
+                    let planted = anchors[side].iter().find(|(r, _, _)| r.contains(&edge));
+                    if let Some((_, xy, yaw)) = planted {
+                        let held = planted_pose(foot, &pose, *xy, *yaw, options.clearance);
+                        (pose.pos.x, pose.pos.y, pose.quat) = (held.pos.x, held.pos.y, held.quat);
+                        changed = true;
+                    }
+                }
+                let low =
+                    options.swing_clearance * rise - pose.pos.z - foot.sole_offset(&quat(&pose));
+                if low > 0.0 {
+                    pose.pos.z += low;
+                    changed = true;
+                }
+            }
+            if changed {
+                if w > 0.0 {
+                    contact[t][side] = foot.contact_points(&pose, w);
+                }
                 targets[t * slots + foot.slot] = pose;
                 weight[t][side] = 1.0 + (options.stance_weight - 1.0) * w;
             }
         }
     }
     FootPlan { shift, weight, contact }
+}
+
+/// Per frame out of stance, the nearer of the planted frames around it (the last before, the
+/// first after; the earlier on a tie) and how many frames away it is; `None` in stance and
+/// where the foot is never planted.
+fn swing_edges(planted: &[bool]) -> Vec<Option<(usize, usize)>> {
+    let mut out = vec![None; planted.len()];
+    let mut last = None;
+    for (t, &p) in planted.iter().enumerate() {
+        if p {
+            last = Some(t);
+        } else if let Some(a) = last {
+            out[t] = Some((a, t - a));
+        }
+    }
+    let mut next = None;
+    for (t, &p) in planted.iter().enumerate().rev() {
+        if p {
+            next = Some(t);
+        } else if let Some(b) = next {
+            if out[t].is_none_or(|(_, d)| b - t < d) {
+                out[t] = Some((b, b - t));
+            }
+        }
+    }
+    out
 }
 
 /// A stance phase (frames) with its anchor: the flat foot's horizontal position and yaw.
@@ -612,6 +682,59 @@ mod tests {
         let before = anchors.clone();
         separate(&foot, &foot, &mut anchors, 0.02);
         assert_eq!(anchors, before);
+    }
+
+    /// One step of a flat box foot (sole 2 cm below its origin) at `fps`: planted for the
+    /// first and last third of a 1 s clip, in between it moves 0.5 m forward barely off the
+    /// floor (1 cm at most). Returns the planned foot targets and the contact labels.
+    fn low_step(fps: f64) -> (Vec<Pose>, Vec<bool>, FootPlan) {
+        let mut foot = box_foot();
+        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+        let frames = fps as usize;
+        let (lift, touch) = (frames / 3, 2 * frames / 3);
+        let labels: Vec<bool> = (0..frames).map(|t| t < lift || t >= touch).collect();
+        let mut targets: Vec<Pose> = (0..frames)
+            .map(|t| {
+                let u = ((t as f64 - lift as f64) / (touch - lift) as f64).clamp(0.0, 1.0);
+                let pos =
+                    Vector3::new(0.5 * u, 0.0, 0.02 + 0.01 * (std::f64::consts::PI * u).sin());
+                Pose { quat: [1.0, 0.0, 0.0, 0.0], pos }
+            })
+            .collect();
+        let contacts = FootContacts { left: labels.clone(), right: vec![false; frames] };
+        let plan =
+            plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, &FootPlanOptions::default());
+        (targets, labels, plan)
+    }
+
+    #[test]
+    fn swing_feet_clear_the_floor_and_lift_before_they_move() {
+        let options = FootPlanOptions::default();
+        for fps in [30.0, 120.0] {
+            let (targets, labels, plan) = low_step(fps);
+            let sole = |p: &Pose| p.pos.z - 0.02;
+            let lift = labels.iter().position(|c| !c).unwrap_or(0);
+            let touch = lift + labels[lift..].iter().position(|c| *c).unwrap_or(0);
+            let lead = (options.lead_s * fps).round() as usize;
+            let rise = (options.lift_s * fps).round() as usize;
+            // Planted frames rest on the floor.
+            assert!((sole(&targets[lift - 1]) - options.clearance).abs() < 1e-9, "fps {fps}");
+            for t in lift..touch - lead {
+                let off = (t + 1 - lift).min(touch - lead - t);
+                let h = sole(&targets[t]);
+                if off >= rise {
+                    // Clear of the floor (the free target is 1 cm up at most).
+                    assert!(h >= options.swing_clearance - 1e-9, "fps {fps} frame {t}: {h}");
+                } else {
+                    // Rising or coming down: over its anchor, above the planted height.
+                    let anchor = if t - lift < touch - lead - t { lift - 1 } else { touch - lead };
+                    let dx = targets[t].pos.x - targets[anchor].pos.x;
+                    assert!(dx.abs() < 1e-9, "fps {fps} frame {t}: {dx}");
+                    assert!(h > options.clearance && h < options.swing_clearance, "{t}: {h}");
+                }
+            }
+            assert_eq!(plan.weight.len(), labels.len());
+        }
     }
 
     #[test]
