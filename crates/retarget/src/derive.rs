@@ -1317,7 +1317,8 @@ pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<Hu
 /// The config for retargeting `bvh` onto `model` when no config was written for the pair:
 /// - `given` (`--config`): as written, or bound to the skeleton when it is role-named;
 /// - `tuned` (a config written for [`LAFAN1_FRAMES`], as the shipped ones are) with `gmr`
-///   (`--gmr`): always the tuned config (GMR's exact behaviour);
+///   (`--gmr`): the tuned config whenever the skeleton has the human bodies it names (GMR's
+///   exact behaviour), else the derived one (GMR stops with a `KeyError` there);
 /// - `tuned` when the skeleton has its human body names and LAFAN1's joint frames
 ///   ([`JointFrames::differs`]: a property of the skeleton, whatever the motion);
 /// - otherwise the config derived from the robot's and the skeleton's roles.
@@ -1343,14 +1344,22 @@ pub fn choose(
         let summary = format!("config {} (role-named), bound to the skeleton", config.source);
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }
-    if let (Some(tuned), true) = (tuned, gmr) {
-        let summary = format!("config {} (tuned; --gmr)", tuned.source);
-        return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-    }
     let mut why_not = String::new();
     if let Some(tuned) = tuned {
         let names = fk::body_names(bvh, fk_options)?;
-        if tuned.validate(model, &names).is_ok() {
+        let fits = tuned.validate(model, &names);
+        if gmr && fits.is_ok() {
+            let summary = format!("config {} (tuned; --gmr)", tuned.source);
+            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
+        }
+        if gmr {
+            // GMR itself stops here (a KeyError on the first missing body); GMR's solve with
+            // the derived config is the nearest thing, and what `--gmr` comparisons need.
+            why_not = format!(
+                " (--gmr: GMR's solve; the tuned {} names bodies the skeleton lacks)",
+                tuned.source
+            );
+        } else if fits.is_ok() {
             let humanoid = fk::recognise(bvh, &fk_options.roles)?;
             let frames = LAFAN1_FRAMES;
             match frames.differs(&humanoid, fk_options.axes) {

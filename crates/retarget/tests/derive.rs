@@ -162,9 +162,18 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
         let chosen = choose(&upright, &default);
         assert_eq!(chosen.choice, Choice::Derived, "upright → {key}: {}", chosen.summary);
         assert!(chosen.summary.contains("from LAFAN1's"), "{}", chosen.summary);
-        // With --gmr the tuned config, whatever the skeleton (GMR's behaviour).
+        // With --gmr the tuned config whenever the skeleton has its names (GMR's behaviour),
+        // whatever its joint frames; GMR's solve with the derived config where it has not
+        // (GMR stops with a KeyError there).
         let gmr = derive::choose(&model, key, &upright, &default, None, Some(&tuned), true);
         assert_eq!(gmr.unwrap().choice, Choice::Tuned);
+        let cmu: Vec<_> = clips.iter().filter(|(name, _)| name.starts_with("cmu")).collect();
+        assert!(!cmu.is_empty(), "the CMU files of the shared data");
+        for (name, bvh) in cmu {
+            let gmr = derive::choose(&model, key, bvh, &default, None, Some(&tuned), true).unwrap();
+            assert_eq!(gmr.choice, Choice::Derived, "{name} --gmr → {key}: {}", gmr.summary);
+            assert!(gmr.summary.contains("--gmr: GMR's solve"), "{}", gmr.summary);
+        }
     }
     assert!(lafan >= robots.len() * 4, "{lafan}: both samples and both shared LAFAN1 files");
 }
