@@ -6,8 +6,9 @@
 //! MuJoCo's compiler does it: default classes and `childclass`, the compiler's `angle` unit and
 //! `eulerseq`, every orientation form (`quat`, `axisangle`, `euler`, `xyaxes`, `zaxis`),
 //! `<frame>`, `fromto`, `autolimits`. The kinematic functions reproduce `mj_kinematics`,
-//! `mj_jac`/`mj_jacBody` and `mj_integratePos`; the `mujoco` feature adds
-//! [`mujoco_check`], which compares everything with MuJoCo 3.17.0 itself.
+//! `mj_jac`/`mj_jacBody` and `mj_integratePos`; the `mujoco` feature adds the module
+//! `mujoco_check`, which compares everything with MuJoCo 3.17.0 itself (a plain name: without
+//! the feature there is nothing to link to, and rustdoc denies the broken link).
 //!
 //! URDF is read into the same [`Model`] ([`Model::from_urdf_file`], [`Model::from_path`]) with
 //! the semantics of MuJoCo's URDF import (static links fused into their parent, visuals
@@ -44,7 +45,8 @@ mod urdf;
 use std::path::Path;
 
 pub use collision::{
-    geom_bounding_sphere, geom_distance, geom_lowest_point, Proximity, SelfCollisionPairs,
+    box_manifold, geom_bounding_sphere, geom_distance, geom_lowest_point, ContactPoint, Manifold,
+    ManifoldFeature, Proximity, SelfCollisionPairs, MAX_MANIFOLD_POINTS,
 };
 pub use error::{Error, Location};
 pub use kinematics::Data;

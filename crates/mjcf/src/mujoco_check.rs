@@ -789,3 +789,242 @@ fn compare_lowest_points(
         report.max_lowest = report.max_lowest.max(dev - allowance);
     }
 }
+
+// ------------------------------------------------------------------------------------------
+// Box–box contact manifolds
+// ------------------------------------------------------------------------------------------
+
+/// Result of [`check_box_manifolds`].
+#[derive(Debug, Clone, Default)]
+pub struct ManifoldReport {
+    /// Poses drawn, and of those with a manifold here.
+    pub configs: usize,
+    pub touching: usize,
+    /// Face manifolds with the incident face within 60° of the reference face, where MuJoCo
+    /// clips the same face: compared point by point (count, midpoints, depths).
+    pub faces: usize,
+    pub face_points: usize,
+    /// Face manifolds with the incident face tilted further, where MuJoCo clips only the
+    /// incident box's edges within 60° of the reference face (one edge or one corner): the
+    /// deepest contact and the normal compared.
+    pub tilted: usize,
+    /// Edge–edge manifolds: one point here; MuJoCo's collider puts several along its own
+    /// normal, so these are compared with `mj_geomDistance` instead (below).
+    pub edges: usize,
+    pub edge_points: usize,
+    /// Boxes apart, with contacts within the margin in MuJoCo and no manifold here: the faces
+    /// (projected along the normal) meet only beside each other, where MuJoCo keeps the
+    /// deepest corner or edge points anyway (and [`crate::geom_distance`] gives the witness).
+    pub beside: usize,
+    /// Largest |our midpoint − MuJoCo's contact position| (m), point by point.
+    pub max_point: f64,
+    /// Largest |our distance − MuJoCo's| (m): point by point, and deepest against deepest.
+    pub max_distance: f64,
+    /// Largest |our normal − MuJoCo's contact normal| (face manifolds).
+    pub max_normal: f64,
+    /// Overlapping poses, and of those where our depth is within 1e-6 m of
+    /// `mj_geomDistance`'s (MuJoCo's GJK/EPA). Where it is not, EPA stopped short: its
+    /// polytope lies inside the Minkowski difference, so an early stop is shallower, and ours
+    /// must then be the deeper (a mismatch otherwise).
+    pub overlapping: usize,
+    pub as_deep_as_epa: usize,
+    /// Poses where the two disagree in kind: overlapping boxes without a manifold here, a
+    /// face manifold without contacts in MuJoCo, a different number of points, or a depth
+    /// shallower than EPA's.
+    pub mismatches: Vec<String>,
+}
+
+impl ManifoldReport {
+    /// No mismatch and every face deviation within `tolerance`.
+    #[must_use]
+    pub fn passes(&self, tolerance: f64) -> bool {
+        self.mismatches.is_empty()
+            && self.max_point <= tolerance
+            && self.max_distance <= tolerance
+            && self.max_normal <= tolerance
+    }
+}
+
+impl fmt::Display for ManifoldReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{} poses, {} with a manifold: {} faces ({} points) compared point by point, {} tilted, {} edge-edge ({} points); {} apart beside the faces",
+            self.configs,
+            self.touching,
+            self.faces,
+            self.face_points,
+            self.tilted,
+            self.edges,
+            self.edge_points,
+            self.beside
+        )?;
+        for m in &self.mismatches {
+            writeln!(f, "  {m}")?;
+        }
+        writeln!(
+            f,
+            "  against mj_collision: |Δpoint| {:.1e} m, |Δdistance| {:.1e} m, |Δnormal| {:.1e}",
+            self.max_point, self.max_distance, self.max_normal
+        )?;
+        write!(
+            f,
+            "  against mj_geomDistance: {} of {} overlapping poses as deep within 1e-6 m",
+            self.as_deep_as_epa, self.overlapping
+        )
+    }
+}
+
+/// [`crate::box_manifold`] against MuJoCo for two free boxes of half sizes `sizes` with geom
+/// margin `margin`, at `options.configs` random relative poses near contact (box 2's centre
+/// within the sum of the bounding radii of box 1's), on MuJoCo's own geom poses:
+/// - face manifolds against the contacts of `mj_collision` (its box–box collider, contacts
+///   no farther than `margin`), which it reports midway between the surfaces (ours: the
+///   midpoint of each point pair);
+/// - where the boxes overlap, the manifold's depth against `mj_geomDistance`'s: never
+///   shallower. (Apart, the two measure different things: a face manifold's points are
+///   pairs of surface points, no closer than the distance; an edge pair's gap along the
+///   normal can be smaller.)
+pub fn check_box_manifolds(
+    sizes: [[f64; 3]; 2],
+    margin: f64,
+    options: CheckOptions,
+) -> Result<ManifoldReport, Error> {
+    let body = |s: [f64; 3]| {
+        format!(
+            r#"<body><freejoint/><geom type="box" size="{} {} {}" margin="{margin}"/></body>"#,
+            s[0], s[1], s[2]
+        )
+    };
+    let xml =
+        format!("<mujoco><worldbody>{}{}</worldbody></mujoco>", body(sizes[0]), body(sizes[1]));
+    let model = Model::from_xml_str(&xml, None)?;
+    let mj = MjModel::from_xml_string(&xml).map_err(|e| mujoco_error(Path::new("<boxes>"), e))?;
+    let reach: f64 = sizes.iter().map(|s| Vector3::from(*s).norm()).sum();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut data = Data::new(&model);
+    let mut mjd = mj.make_data();
+    let mut report = ManifoldReport { configs: options.configs, ..ManifoldReport::default() };
+    for c in 0..options.configs {
+        let mut qpos = model.random_qpos(&mut rng);
+        qpos[..3].fill(0.0);
+        for v in &mut qpos[7..10] {
+            *v = rand::Rng::gen_range(&mut rng, -reach..reach);
+        }
+        mjd.qpos_mut().copy_from_slice(&qpos);
+        mjd.forward();
+        for g in 0..2 {
+            data.geom_xpos[g] = Vector3::from(mjd.geom_xpos()[g]);
+            data.geom_xmat[g] = nalgebra::Matrix3::from_row_slice(&mjd.geom_xmat()[g]);
+        }
+        let ours = crate::box_manifold(&model, &data, 0, 1, margin);
+        // Contact normals from geom 0 to geom 1.
+        let theirs: Vec<Contact> = mjd
+            .contact()
+            .iter()
+            .filter(|k| k.dist <= margin)
+            .map(|k| {
+                let n = Vector3::new(k.frame[0], k.frame[1], k.frame[2]);
+                Contact {
+                    pos: Vector3::from(k.pos),
+                    dist: k.dist,
+                    normal: if k.geom[0] == 0 { n } else { -n },
+                }
+            })
+            .collect();
+        if let Some(m) = &ours {
+            let exact = mjd.geom_distance(0, 1, 2.0 * reach, None);
+            compare_with_epa(c, m.distance(), exact, &mut report);
+        }
+        compare_manifold(c, ours.as_ref(), &theirs, &data, &mut report);
+    }
+    Ok(report)
+}
+
+/// One contact of `mj_collision` (normal from geom 0 to geom 1).
+struct Contact {
+    pos: Vector3<f64>,
+    dist: f64,
+    normal: Vector3<f64>,
+}
+
+fn compare_with_epa(config: usize, ours: f64, exact: f64, report: &mut ManifoldReport) {
+    if ours >= 0.0 && exact >= 0.0 {
+        return;
+    }
+    report.overlapping += 1;
+    report.as_deep_as_epa += usize::from((ours - exact).abs() <= 1e-6);
+    if ours > exact + 1e-9 {
+        report.mismatches.push(format!(
+            "pose {config}: distance {ours:.9}, shallower than mj_geomDistance's {exact:.9}"
+        ));
+    }
+}
+
+fn compare_manifold(
+    config: usize,
+    ours: Option<&crate::Manifold>,
+    theirs: &[Contact],
+    data: &Data,
+    report: &mut ManifoldReport,
+) {
+    use crate::ManifoldFeature::{Edges, Face1, Face2};
+    let Some(m) = ours else {
+        if theirs.iter().any(|t| t.dist < 0.0) {
+            report.mismatches.push(format!(
+                "pose {config}: {} contacts in mujoco, one penetrating; none here",
+                theirs.len()
+            ));
+        } else if !theirs.is_empty() {
+            report.beside += 1;
+        }
+        return;
+    };
+    report.touching += 1;
+    let incident = match m.feature {
+        Edges(..) => {
+            report.edges += 1;
+            report.edge_points += m.points().len();
+            return;
+        }
+        Face1(_) => 1,
+        Face2(_) => 0,
+    };
+    let Some(first) = theirs.first() else {
+        report
+            .mismatches
+            .push(format!("pose {config}: {:?} here, no contact in mujoco", m.feature));
+        return;
+    };
+    let deepest = theirs.iter().map(|t| t.dist).fold(f64::INFINITY, f64::min);
+    report.max_distance = report.max_distance.max((deepest - m.distance()).abs());
+    report.max_normal = report.max_normal.max((first.normal - m.normal).norm());
+    // MuJoCo clips a whole face when two of the incident box's axes are within 60° of the
+    // reference face (|cos| < 0.5 to its normal).
+    let in_plane =
+        (0..3).filter(|&k| data.geom_xmat[incident].column(k).dot(&m.normal).abs() < 0.5).count();
+    if in_plane < 2 {
+        report.tilted += 1;
+        return;
+    }
+    report.faces += 1;
+    if m.points().len() != theirs.len() {
+        report.mismatches.push(format!(
+            "pose {config}: {:?} with {} points, mujoco {}",
+            m.feature,
+            m.points().len(),
+            theirs.len()
+        ));
+        return;
+    }
+    for p in m.points() {
+        report.face_points += 1;
+        let mid = (p.point1 + p.point2) / 2.0;
+        let nearest =
+            theirs.iter().min_by(|x, y| (x.pos - mid).norm().total_cmp(&(y.pos - mid).norm()));
+        if let Some(t) = nearest {
+            report.max_point = report.max_point.max((t.pos - mid).norm());
+            report.max_distance = report.max_distance.max((t.dist - p.distance).abs());
+        }
+    }
+}
