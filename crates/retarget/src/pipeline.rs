@@ -389,12 +389,30 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(p) = &self.options.mode {
             if p.smoothing_passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, p.smoothing_passes);
+                let ground = crate::constraints::collision_primitives(self.model);
+                let pairs = if p.self_collision == SelfCollisionMode::On {
+                    self.model.self_collision_pairs().pairs
+                } else {
+                    Vec::new()
+                };
+                let mut scratch = mjcf::Data::new(self.model);
                 solver.set_qpos(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
                     solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
                     reject_divergence(solver.qpos(), f)?;
+                    // The repair's rows are linearised at the smoothed pose; where its step
+                    // went far enough to leave a geom in the floor, the first pass's pose
+                    // (which held every constraint) stays.
+                    let depth = violation(self.model, solver.data(), &ground, &pairs, p.floor);
+                    if depth > REPAIR_SLACK {
+                        let first_pass = &qpos[k * nq..(k + 1) * nq];
+                        self.model.kinematics(first_pass, &mut scratch);
+                        if violation(self.model, &scratch, &ground, &pairs, p.floor) < depth {
+                            solver.keep(first_pass)?;
+                        }
+                    }
                     qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
                     let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
                     (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
@@ -605,6 +623,31 @@ fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize) -> Vec<f64> {
         }
     }
     out
+}
+
+/// How deep (m) a repaired frame may leave a collision geom in the floor or two in each
+/// other before the first pass's pose is kept instead (the report counts from 1 cm).
+const REPAIR_SLACK: f64 = 0.002;
+
+/// The deepest violation (m) in `data`: of the lowest of `geoms` below `floor`, and of any of
+/// `pairs` into each other; 0 when there is none.
+fn violation(
+    model: &Model,
+    data: &mjcf::Data,
+    geoms: &[usize],
+    pairs: &[[usize; 2]],
+    floor: f64,
+) -> f64 {
+    let ground = geoms
+        .iter()
+        .filter_map(|&g| mjcf::geom_lowest_point(model, data, g))
+        .map(|p| floor - p.z)
+        .fold(0.0, f64::max);
+    pairs
+        .iter()
+        .filter_map(|&[a, b]| mjcf::geom_distance(model, data, a, b, 0.0))
+        .map(|p| -p.distance)
+        .fold(ground, f64::max)
 }
 
 /// The robot's two feet (sole bodies, as the report finds them) with the task that moves

@@ -356,6 +356,21 @@ impl<'m> Solver<'m> {
         Ok(())
     }
 
+    /// Makes `qpos` this frame's result after all (as if the last solve or repair had ended
+    /// there): the current configuration and the one the next frame's speed limits are
+    /// measured from.
+    pub fn keep(&mut self, qpos: &[f64]) -> Result<(), Error> {
+        self.set_qpos(qpos)?;
+        self.previous.copy_from_slice(qpos);
+        Ok(())
+    }
+
+    /// The current kinematics (of [`Solver::qpos`]).
+    #[must_use]
+    pub fn data(&self) -> &Data {
+        &self.data
+    }
+
     /// Bodies with a task, first occurrence over the stages, as `(body id, target slot)`.
     #[must_use]
     pub fn tracked(&self) -> &[(usize, usize)] {
