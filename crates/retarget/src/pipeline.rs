@@ -405,7 +405,14 @@ impl<'a> Prepared<'a> {
                     // The repair's rows are linearised at the smoothed pose; where its step
                     // went far enough to leave a geom in the floor, the first pass's pose
                     // (which held every constraint) stays.
-                    let depth = violation(self.model, solver.data(), &ground, &pairs, p.floor);
+                    // (A short step stays where the rows describe it: nothing to check.)
+                    let moved = solver.qpos().iter().zip(reference).map(|(a, b)| (a - b).abs());
+                    let far = moved.fold(0.0, f64::max) > REPAIR_TRUSTED_STEP;
+                    let depth = if far {
+                        violation(self.model, solver.data(), &ground, &pairs, p.floor)
+                    } else {
+                        0.0
+                    };
                     if depth > REPAIR_SLACK {
                         let first_pass = &qpos[k * nq..(k + 1) * nq];
                         self.model.kinematics(first_pass, &mut scratch);
@@ -628,6 +635,11 @@ fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize) -> Vec<f64> {
 /// How deep (m) a repaired frame may leave a collision geom in the floor or two in each
 /// other before the first pass's pose is kept instead (the report counts from 1 cm).
 const REPAIR_SLACK: f64 = 0.002;
+
+/// A repair step that moves no coordinate further than this (rad or m) from the smoothed pose
+/// is not checked: its linearised rows still describe where it ends (the first pass makes
+/// its rows again beyond the same distance).
+const REPAIR_TRUSTED_STEP: f64 = 0.02;
 
 /// The deepest violation (m) in `data`: of the lowest of `geoms` below `floor`, and of any of
 /// `pairs` into each other; 0 when there is none.
