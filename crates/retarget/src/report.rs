@@ -412,12 +412,7 @@ fn collisions(
     model: &mjcf::Model,
     opts: &ReportOptions,
 ) -> (GroundPenetration, SelfCollision) {
-    let robot_geom = |g: usize| model.geoms[g].body != 0 && model.geoms[g].kind.is_primitive();
-    let geoms: Vec<usize> = (0..model.geoms.len())
-        .filter(|&g| {
-            robot_geom(g) && (model.geoms[g].contype != 0 || model.geoms[g].conaffinity != 0)
-        })
-        .collect();
+    let geoms = crate::constraints::collision_primitives(model);
     let mut data = mjcf::Data::new(model);
     let selection = model.self_collision_pairs();
     let pairs = selection.pairs;
