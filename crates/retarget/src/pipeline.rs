@@ -382,7 +382,7 @@ impl<'a> Prepared<'a> {
         // the self-collision rows: 1402 frames > 1 cm against 14.)
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
-            frames.push(solver.solve_frame(self.frame_targets(f), dt)?);
+            frames.push(solver.solve_frame(self.frame_targets(f), first_frame_dt(f == first, dt))?);
             reject_divergence(solver.qpos(), f)?;
             qpos.extend_from_slice(solver.qpos());
         }
@@ -396,7 +396,11 @@ impl<'a> Prepared<'a> {
                     Vec::new()
                 };
                 let mut scratch = mjcf::Data::new(self.model);
-                solver.set_qpos(&smooth[..nq])?;
+                // `keep`, not `set_qpos`: the repair's speed limits count from the frame before,
+                // and before the first there is none. (They counted from the first pass's last
+                // frame: the PM01's jumps began with its left hip pulled towards the end pose,
+                // twisted 164°.)
+                solver.keep(&smooth[..nq])?;
                 for (k, f) in (first..end).enumerate() {
                     self.set_frame_tasks(&mut solver, f)?;
                     let reference = &smooth[k * nq..(k + 1) * nq];
@@ -551,6 +555,18 @@ pub(crate) fn build_solver<'m>(
         }
     }
     Ok(solver)
+}
+
+/// The `dt` a solve's first frame is solved with: 0, so that no joint speed limit holds
+/// there. Its start configuration (`qpos0`, or [`start_pose`]) is no frame of the motion:
+/// limits counted from it held the G1's joints up to 1.6 rad back on clips that begin
+/// mid-motion (`tests/plausible.rs`).
+pub(crate) fn first_frame_dt(first: bool, dt: f64) -> f64 {
+    if first {
+        0.0
+    } else {
+        dt
+    }
 }
 
 /// `qpos0` with the free root moved to one frame's target (`targets`, by slot) of the root

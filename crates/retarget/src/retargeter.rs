@@ -601,7 +601,7 @@ impl Stream {
                     solver.set_qpos(&start)?;
                 }
             }
-            let diag = solver.solve_frame(targets, dt)?;
+            let diag = solver.solve_frame(targets, crate::pipeline::first_frame_dt(first, dt))?;
             crate::pipeline::reject_divergence(solver.qpos(), index)?;
             Ok::<_, Error>(diag)
         })?;
