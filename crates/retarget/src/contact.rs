@@ -19,7 +19,9 @@
 // `HumanMotion::validate` checked against its arrays.
 #![allow(clippy::indexing_slicing)]
 
-use fk::HumanMotion;
+use std::collections::BTreeMap;
+
+use fk::{HumanMotion, Role};
 use nalgebra::Vector3;
 
 use crate::motion::FootContacts;
@@ -57,20 +59,32 @@ pub struct FootPoints {
     pub toe: Option<usize>,
 }
 
-/// The heel and toe bodies of each foot (`[left, right]`) among the human body names, by
-/// the common names (LAFAN1, Mixamo-style, CMU, Xsens, C3D marker bodies); `None` when a
-/// heel is missing.
+/// The heel and toe bodies of each foot (`[left, right]`) among the human body names: the
+/// joints playing the foot and toe roles in `roles` (the skeleton recogniser's, any naming
+/// convention: `fk::recognise`), else by the common names (LAFAN1, Mixamo-style, CMU, Xsens,
+/// C3D marker bodies, for motions given without roles); `None` when a heel is missing.
 #[must_use]
-pub fn human_foot_points(names: &[String]) -> Option<[FootPoints; 2]> {
+pub fn human_foot_points(
+    names: &[String],
+    roles: &BTreeMap<Role, String>,
+) -> Option<[FootPoints; 2]> {
     let find = |candidates: &[&str]| {
         candidates.iter().find_map(|c| names.iter().position(|n| n.eq_ignore_ascii_case(c)))
     };
-    let side = |s: &str| -> Option<FootPoints> {
+    let by_role =
+        |role: Role| roles.get(&role).and_then(|joint| names.iter().position(|n| n == joint));
+    let side = |s: &str, foot: Role, toe: Role| -> Option<FootPoints> {
+        if let Some(heel) = by_role(foot) {
+            return Some(FootPoints { heel, toe: by_role(toe) });
+        }
         let heel = find(&[&format!("{s}Foot"), &format!("{s}Ankle")])?;
         let toe = find(&[&format!("{s}ToeBase"), &format!("{s}Toe"), &format!("{s}Toes")]);
         Some(FootPoints { heel, toe })
     };
-    Some([side("Left")?, side("Right")?])
+    Some([
+        side("Left", Role::LeftFoot, Role::LeftToe)?,
+        side("Right", Role::RightFoot, Role::RightToe)?,
+    ])
 }
 
 /// Contact phases of both feet (`[left, right]`) over the clip.

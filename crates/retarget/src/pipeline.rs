@@ -128,6 +128,8 @@ pub struct RetargetOptions {
     /// Subject height in metres; `None` uses the FK estimate (GMR assumes 1.75).
     pub human_height: Option<f64>,
     pub solver: SolverOptions,
+    /// FK options. Their `roles` also name the source's feet for the contact phases
+    /// ([`crate::contact::human_foot_points`]); [`retarget_bvh`] adds the recognised ones.
     pub fk: FkOptions,
     /// Solve long clips as parallel chunks ([`crate::chunked`]); `None`: one serial pass.
     pub chunk: Option<crate::chunked::ChunkOptions>,
@@ -219,6 +221,12 @@ pub fn retarget_bvh(
     let (human, report) = fk::human_motion(bvh, &fk_options)?;
     let mut opts = options.clone();
     opts.human_height = Some(report.height);
+    // The recognised roles, so that the source's feet are found whatever their names.
+    if let Ok(humanoid) = &report.humanoid {
+        for (role, joint) in humanoid.roles.iter() {
+            opts.fk.roles.entry(role).or_insert_with(|| joint.name.clone());
+        }
+    }
     let (motion, mut diag) = match options.chunk {
         Some(chunk) => {
             crate::chunked::retarget_motion_chunked(&human, model, config, &opts, chunk)?
@@ -316,7 +324,9 @@ impl<'a> Prepared<'a> {
             SolveMode::Plausible(p) => p.contact.clone(),
             SolveMode::Gmr => crate::contact::ContactOptions::default(),
         };
-        if let Some(points) = crate::contact::human_foot_points(&human.body_names) {
+        if let Some(points) =
+            crate::contact::human_foot_points(&human.body_names, &options.fk.roles)
+        {
             prepared.contacts = Some(crate::contact::detect(human, points, &contact));
         }
         if let SolveMode::Plausible(plausible) = &options.mode {

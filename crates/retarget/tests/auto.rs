@@ -48,6 +48,9 @@ struct Checks {
     /// Frames × joints outside their range.
     violations: usize,
     choice: Choice,
+    /// Share of frames in which the source's left / right foot is in contact (the feet are
+    /// found by their roles, whatever the skeleton names them); `None` without contacts.
+    contact: Option<[f64; 2]>,
 }
 
 fn run(model: &mjcf::Model, robot: &str, bvh: &bvh::Bvh, tuned: Option<&IkConfig>) -> Checks {
@@ -60,7 +63,12 @@ fn run(model: &mjcf::Model, robot: &str, bvh: &bvh::Bvh, tuned: Option<&IkConfig
     let (human, report) = fk::human_motion(bvh, &fk_options).unwrap();
     let humanoid = report.humanoid.unwrap();
     let roles = RobotRoles::recognise(model).unwrap();
-    measure(model, &roles, &motion, &human, &humanoid, chosen.choice)
+    let mut checks = measure(model, &roles, &motion, &human, &humanoid, chosen.choice);
+    checks.contact = motion.contacts.as_ref().map(|c| {
+        let share = |v: &[bool]| v.iter().filter(|&&x| x).count() as f64 / v.len().max(1) as f64;
+        [share(&c.left), share(&c.right)]
+    });
+    checks
 }
 
 fn measure(
@@ -129,6 +137,7 @@ fn measure(
         alternations: (alternations(&robot_steps), alternations(&human_steps)),
         violations: violations(model, motion),
         choice,
+        contact: None,
     }
 }
 
@@ -207,6 +216,12 @@ fn every_shared_bvh_onto_the_g1_and_the_t1() {
             let name = file.file_name().unwrap().to_string_lossy().into_owned();
             let checks = run(&model, key, &bvh, tuned.as_ref());
             let walk = name.contains("walk");
+            // The source's feet are found by their roles on every skeleton (before, by a few
+            // names: Bandai's `Foot_L`, Rigify's `DEF-foot.L` had no contacts, so no planting).
+            let contact = checks.contact.unwrap_or_else(|| panic!("{name}: no source contacts"));
+            if walk {
+                assert!(contact.iter().all(|&c| c > 0.3), "{name}: contact shares {contact:?}");
+            }
             if name.contains("mocapbank") {
                 // Known open problem: on this skeleton the human's canonical pelvis and chest
                 // frames are not upright in half the frames (fk's reference pose), and the
