@@ -20,6 +20,28 @@ fn g1() -> mjcf::Model {
     model
 }
 
+/// Frames `range` of `full`.
+fn slice(full: &fk::HumanMotion, range: std::ops::Range<usize>) -> fk::HumanMotion {
+    let nb = full.num_bodies();
+    fk::HumanMotion {
+        num_frames: range.len(),
+        positions: full.positions[range.start * nb..range.end * nb].to_vec(),
+        orientations: full.orientations[range.start * nb..range.end * nb].to_vec(),
+        ..full.clone()
+    }
+}
+
+/// The G1, its tuned config, the shared LAFAN1 jumps take's human motion and its subject
+/// height; `None` without the shared data.
+fn g1_jumps() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
+    let path = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh")?;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let (full, report) =
+        fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
+    Some((g1(), config, full, report.height))
+}
+
 /// Frames `range` of a shared LAFAN1 take, retargeted onto the G1 with `base`, and its report.
 fn solve(
     take: &str,
@@ -32,14 +54,7 @@ fn solve(
     let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
     let bvh = bvh::from_path(&path).unwrap();
     let (full, human_report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
-    let nb = full.num_bodies();
-    let n = range.len();
-    let human = fk::HumanMotion {
-        num_frames: n,
-        positions: full.positions[range.start * nb..range.end * nb].to_vec(),
-        orientations: full.orientations[range.start * nb..range.end * nb].to_vec(),
-        ..full
-    };
+    let human = slice(&full, range);
     let options = RetargetOptions { human_height: Some(human_report.height), ..base };
     let (motion, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     assert!(motion.contacts.is_some(), "both solves carry the source's contacts");
@@ -134,28 +149,14 @@ fn the_repair_pass_leaves_nothing_in_the_floor_or_in_itself() {
 /// whole take with its left hip twisted 164°.
 #[test]
 fn the_first_frame_is_not_pulled_towards_the_last() {
-    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh") else {
-        return;
-    };
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let model = g1();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
-    let (full, human_report) =
-        fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
-    let (nb, end) = (full.num_bodies(), 800);
-    let human = fk::HumanMotion {
-        num_frames: end,
-        positions: full.positions[..end * nb].to_vec(),
-        orientations: full.orientations[..end * nb].to_vec(),
-        ..full
-    };
+    let Some((model, config, full, height)) = g1_jumps() else { return };
+    let human = slice(&full, 0..800);
     let solve = |passes: usize| {
         let mode = retarget::SolveMode::Plausible(retarget::PlausibleOptions {
             smoothing_passes: passes,
             ..Default::default()
         });
-        let options =
-            RetargetOptions { human_height: Some(human_report.height), mode, ..Default::default() };
+        let options = RetargetOptions { human_height: Some(height), mode, ..Default::default() };
         retarget_motion(&human, &model, &config, &options).unwrap().0
     };
     let (smoothed, first_pass) = (solve(1), solve(0));
@@ -176,28 +177,11 @@ fn the_first_frame_is_not_pulled_towards_the_last() {
 /// the rest are other solutions of the same frame).
 #[test]
 fn a_clip_that_begins_mid_motion_tracks_from_its_first_frame() {
-    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh") else {
-        return;
-    };
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let model = g1();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
-    let (full, human_report) =
-        fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
-    let nb = full.num_bodies();
+    let Some((model, config, full, height)) = g1_jumps() else { return };
     let nq = model.nq;
     let solve = |from: usize, to: usize| {
-        let human = fk::HumanMotion {
-            num_frames: to - from,
-            positions: full.positions[from * nb..to * nb].to_vec(),
-            orientations: full.orientations[from * nb..to * nb].to_vec(),
-            ..full.clone()
-        };
-        let options = RetargetOptions {
-            human_height: Some(human_report.height),
-            ..RetargetOptions::causal()
-        };
-        retarget_motion(&human, &model, &config, &options).unwrap().0
+        let options = RetargetOptions { human_height: Some(height), ..RetargetOptions::causal() };
+        retarget_motion(&slice(&full, from..to), &model, &config, &options).unwrap().0
     };
     let mut differences: Vec<f64> = (1..=10)
         .map(|k| {
