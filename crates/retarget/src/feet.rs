@@ -5,7 +5,10 @@
 //!
 //! 1. **Floor**: all targets move by one vertical shift per clip, the median over the
 //!    stance samples of "how far the foot target must move for its sole to rest on z = 0"
-//!    (the source's floor becomes the robot's floor; jumps keep their height).
+//!    (the source's floor becomes the robot's floor; jumps keep their height). Then, in
+//!    every frame, two feet alongside each other are moved apart sideways until their soles
+//!    are [`FootPlanOptions::sole_gap`] apart (the scaled human's feet can pass closer than
+//!    the robot's fit).
 //! 2. **Planting**: during a stance phase the foot target's horizontal position and yaw are
 //!    the phase's anchor ([`Anchor`]), its z puts the sole's lowest point at
 //!    [`FootPlanOptions::clearance`] for the target's tilt (heel and toe rolls stay the
@@ -73,7 +76,8 @@ pub struct FootPlanOptions {
     /// Least horizontal gap (m) between the two soles when both are planted at once: anchors
     /// closer than this are moved apart, half the shortfall each, along the footprints'
     /// separating axis, so that the planted feet do not ask for the soles inside each other,
-    /// which the self-collision constraint then fights.
+    /// which the self-collision constraint then fights. In every frame, soles alongside each
+    /// other are also kept this far apart sideways ([`keep_feet_apart`]), before planting.
     pub sole_gap: f64,
     /// Least height (m) of the sole's lowest point above the floor out of stance, once the
     /// foot has risen ([`FootPlanOptions::lift_s`]).
@@ -330,6 +334,9 @@ pub fn plan(
     for p in targets.iter_mut() {
         p.pos.z += shift;
     }
+    if let [Some(left), Some(right)] = feet {
+        keep_feet_apart(left, right, targets, slots, options.sole_gap);
+    }
     let blend = (options.blend_s * fps).round().max(0.0) as usize;
     let lead = (options.lead_s * fps).round().max(0.0) as usize;
     let mut weight = vec![[1.0; 2]; frames];
@@ -478,6 +485,62 @@ fn pivot(foot: &RobotFoot, xy: Vector3<f64>, yaw0: f64, yaw: f64) -> Vector3<f64
     let c = foot.toe_point();
     let d = foot.flat(yaw0) * c - foot.flat(yaw) * c;
     Vector3::new(xy.x + d.x, xy.y + d.y, xy.z)
+}
+
+/// Sideways push between the two feet ([`keep_feet_apart`]) fades in over this much (m) of
+/// forward distance as the soles come alongside each other.
+const ALONGSIDE_FADE: f64 = 0.05;
+
+/// At most this much (m) of sideways push between the two feet: a step that crosses over
+/// (a dance) is narrowed, not uncrossed.
+const MAX_WIDENING: f64 = 0.1;
+
+/// Moves the two foot targets of every frame apart sideways (perpendicular to their mean
+/// heading, half each) until the inner edges of their flat soles are `gap` apart, while the
+/// soles are alongside each other: the push fades out over [`ALONGSIDE_FADE`] once one is
+/// `gap` ahead of the other, and is at most [`MAX_WIDENING`]. The scaled human's feet can pass
+/// closer than the robot's feet fit (ToddlerBot: 4.9 cm apart, median, against soles 4.2 cm
+/// wide); the self-collision rows then stop a foot short of its anchor, and it catches up
+/// later at a skate.
+fn keep_feet_apart(
+    left: &RobotFoot,
+    right: &RobotFoot,
+    targets: &mut [Pose],
+    slots: usize,
+    gap: f64,
+) {
+    if left.corners.is_empty() || right.corners.is_empty() || gap.is_nan() || gap < 0.0 {
+        return;
+    }
+    let frames = targets.len().checked_div(slots).unwrap_or(0);
+    for t in 0..frames {
+        let (l, r) = (targets[t * slots + left.slot], targets[t * slots + right.slot]);
+        let (yl, yr) = (left.yaw(&quat(&l)), right.yaw(&quat(&r)));
+        let yaw = (yl.sin() + yr.sin()).atan2(yl.cos() + yr.cos());
+        let lateral = Vector3::new(-yaw.sin(), yaw.cos(), 0.0);
+        let forward = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
+        // How far a flat sole reaches from its body origin along `axis`.
+        let reach = |foot: &RobotFoot, axis: Vector3<f64>| {
+            let flat = foot.flat(yaw);
+            foot.corners.iter().map(|c| (flat * c).dot(&axis)).fold(0.0, f64::max)
+        };
+        let apart = (l.pos - r.pos).dot(&lateral);
+        let short = reach(left, -lateral) + reach(right, lateral) + gap - apart;
+        if short <= 0.0 {
+            continue;
+        }
+        let ahead = (l.pos - r.pos).dot(&forward);
+        let clear = if ahead >= 0.0 {
+            ahead - reach(left, -forward) - reach(right, forward)
+        } else {
+            -ahead - reach(left, forward) - reach(right, -forward)
+        };
+        let alongside =
+            smoothstep(((gap + ALONGSIDE_FADE - clear) / ALONGSIDE_FADE).clamp(0.0, 1.0));
+        let push = (short * alongside).min(MAX_WIDENING) / 2.0;
+        targets[t * slots + left.slot].pos += lateral * push;
+        targets[t * slots + right.slot].pos -= lateral * push;
+    }
 }
 
 /// Per frame out of stance, the nearer of the planted frames around it (the last before, the
@@ -828,6 +891,27 @@ mod tests {
             assert!((yaw(p) - 10f64.to_radians()).abs() < 1e-6, "yaw {}", yaw(p));
             assert!((p.pos - targets[0].pos).norm() < 1e-9);
         }
+    }
+
+    #[test]
+    fn feet_alongside_each_other_are_kept_apart_sideways() {
+        let (left, mut right) = (box_foot(), box_foot());
+        right.slot = 1;
+        let at = |x: f64, y: f64| Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(x, y, 0.0) };
+        let apart = |left_x: f64, left_y: f64, right_y: f64| {
+            let mut targets = vec![at(left_x, left_y), at(0.0, right_y)];
+            keep_feet_apart(&left, &right, &mut targets, 2, 0.03);
+            (targets[0].pos - targets[1].pos, targets[0].pos.x - left_x)
+        };
+        // Side by side, 6 cm apart: soles 10 cm wide need 13 cm (half the push each).
+        let (d, dx) = apart(0.0, 0.03, -0.03);
+        assert!((d.y - 0.13).abs() < 1e-12 && d.x.abs() < 1e-12 && dx.abs() < 1e-12, "{d}");
+        // Already far enough apart, or one well ahead of the other: left alone.
+        assert!((apart(0.0, 0.1, -0.1).0.y - 0.2).abs() < 1e-12);
+        assert!((apart(0.5, 0.03, -0.03).0.y - 0.06).abs() < 1e-12);
+        // Crossed over by 20 cm: narrowed by at most MAX_WIDENING, not uncrossed.
+        let (d, _) = apart(0.0, -0.1, 0.1);
+        assert!((d.y - (-0.2 + MAX_WIDENING)).abs() < 1e-12, "{d}");
     }
 
     #[test]
