@@ -77,7 +77,7 @@ pub struct FootPlanOptions {
     /// closer than this are moved apart, half the shortfall each, along the footprints'
     /// separating axis, so that the planted feet do not ask for the soles inside each other,
     /// which the self-collision constraint then fights. In every frame, soles alongside each
-    /// other are also kept this far apart sideways ([`keep_feet_apart`]), before planting.
+    /// other are also kept this far apart sideways (`keep_feet_apart`), before planting.
     pub sole_gap: f64,
     /// Least height (m) of the sole's lowest point above the floor out of stance, once the
     /// foot has risen ([`FootPlanOptions::lift_s`]).
