@@ -387,7 +387,9 @@ pub fn plan(
         let Some(foot) = foot else { continue };
         let free = &free_targets[side];
         let mut ramp = vec![Ramp::default(); frames];
-        let mut planted = vec![false; frames];
+        // Per planted frame, where the flat foot stands: its horizontal position and yaw (a
+        // pivot's turned with the source's).
+        let mut held: Vec<Option<(Vector3<f64>, f64)>> = vec![None; frames];
         for (r, xy, yaw) in &anchors[side] {
             let (xy, yaw) = (*xy, *yaw);
             let pivots = turn_of(&free_yaw[side][r.clone()], yaw) > options.pivot_turn;
@@ -400,7 +402,7 @@ pub fn plan(
                 let pose = planted_pose(foot, &free[t], xy, yaw, options.clearance);
                 contact[t][side] = foot.contact_points(&pose, 1.0);
                 targets[t * slots + foot.slot] = pose;
-                planted[t] = true;
+                held[t] = Some((xy, yaw));
             }
             // Offsets at touch-down and lift-off, faded in before and out after.
             let edges = [(r.start, -1_isize), (r.end - 1, 1)];
@@ -416,9 +418,9 @@ pub fn plan(
                 }
             }
         }
-        let edges = swing_edges(&planted);
+        let edges = swing_edges(&held.iter().map(Option::is_some).collect::<Vec<_>>());
         for t in 0..frames {
-            if planted[t] {
+            if held[t].is_some() {
                 weight[t][side] = options.stance_weight;
                 continue;
             }
@@ -432,19 +434,11 @@ pub fn plan(
                 // (The tolerance: at 30 fps and 1/30 s, one frame is all the way up.)
                 let rise = smoothstep((frames_off as f64 / (options.lift_s * fps) + 1e-9).min(1.0));
                 if rise < 1.0 {
-                    // Still rising (or already coming down): over the anchor, rolled as the
-                    // free target is tilted.
-                    let planted = anchors[side].iter().find(|(r, _, _)| r.contains(&edge));
-                    if let Some((r, xy, yaw)) = planted {
-                        // Over the edge's planted pose (a pivot's turned one).
-                        let (xy, yaw) =
-                            if turn_of(&free_yaw[side][r.clone()], *yaw) > options.pivot_turn {
-                                (pivot(foot, *xy, *yaw, free_yaw[side][edge]), free_yaw[side][edge])
-                            } else {
-                                (*xy, *yaw)
-                            };
-                        let held = planted_pose(foot, &pose, xy, yaw, options.clearance);
-                        (pose.pos.x, pose.pos.y, pose.quat) = (held.pos.x, held.pos.y, held.quat);
+                    // Still rising (or already coming down): where the foot stood at the edge,
+                    // rolled as the free target is tilted.
+                    if let Some((xy, yaw)) = held[edge] {
+                        let over = planted_pose(foot, &pose, xy, yaw, options.clearance);
+                        (pose.pos.x, pose.pos.y, pose.quat) = (over.pos.x, over.pos.y, over.quat);
                         changed = true;
                     }
                 }
