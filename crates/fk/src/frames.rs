@@ -19,7 +19,7 @@
 //!   of ±F, as an arm raised forward: y = L made perpendicular, x = y × z); the hand
 //!   continues the forearm's axis and x;
 //! - foot, toe: x = heel-to-toe direction (foot → toe) made perpendicular to U (F when there
-//!   is no toe), z = U made perpendicular to x.
+//!   is no toe, or when the foot points more than 60° down), z = U made perpendicular to x.
 //!
 //! Standing upright facing +x with the arms hanging, every frame but the clavicles' is the
 //! identity. A body's frame rotates with its bone, so for a joint with world orientation `q`
@@ -36,6 +36,8 @@ use crate::roles::{Part, Role, Side};
 const DEGENERATE: f64 = 1e-6;
 /// sin 30°: a limb closer than this to the forward axis takes its x from the left axis.
 const ALONG_FORWARD: f64 = 0.5;
+/// cos 60°: a foot whose heel-to-toe direction is steeper than 60° faces forward.
+const STEEP_FOOT: f64 = 0.5;
 
 /// Canonical frame (world-from-frame rotation, in the input's coordinates) of every role
 /// whose geometry the given points determine. `points` are joint positions per role in any
@@ -101,8 +103,15 @@ pub fn canonical_frames(
         }
         let foot = at(foot_role);
         let toe = at(toe_role);
+        // A foot pitched more than 60° (pushing off, as in a run's reference frame) points
+        // its toe nearly down: the rest of the heel-to-toe direction says little about which
+        // way the foot faces (the Bandai run's left foot: backwards), so it faces forward.
         let heel_to_toe = match (foot, toe) {
-            (Some(f), Some(t)) => unit(body.perpendicular(t - f), body.size),
+            (Some(f), Some(t))
+                if body.perpendicular(t - f).norm() >= STEEP_FOOT * (t - f).norm() =>
+            {
+                unit(body.perpendicular(t - f), body.size)
+            }
             _ => None,
         }
         .unwrap_or(body.forward);
@@ -260,6 +269,23 @@ mod tests {
         assert!((m * Vector3::z() + Vector3::x()).norm() < 1e-12);
         assert!((m * Vector3::y() - Vector3::y()).norm() < 1e-12);
         assert!((m * Vector3::x() - Vector3::z()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn a_foot_pointing_down_faces_forward() {
+        // Pushing off: the left toe 70° below the heel-to-toe horizontal and a little behind
+        // and outside the foot. The little that is horizontal points back and out; the foot
+        // faces forward, as the body does.
+        let mut p = standing();
+        let (down, back, out) = (0.14 * 70f64.to_radians().sin(), 0.04, 0.02);
+        p.insert(Role::LeftToe, Vector3::new(-back, 0.1 + out, 0.08 - down));
+        let m = canonical_frames(&p)[&Role::LeftFoot].to_rotation_matrix();
+        assert!((m * Vector3::x() - Vector3::x()).norm() < 1e-12, "{m}");
+        // Pitched 50°, the foot still says which way it faces: back and out.
+        p.insert(Role::LeftToe, Vector3::new(-back, 0.1 + out, 0.08 - 0.06));
+        let m = canonical_frames(&p)[&Role::LeftFoot].to_rotation_matrix();
+        let x = m * Vector3::x();
+        assert!(x.x < 0.0 && x.y > 0.0 && x.z.abs() < 1e-12, "{m}");
     }
 
     #[test]
