@@ -320,6 +320,12 @@ const FLEXION_TWISTED: [Part; 2] = [Part::Thigh, Part::Shin];
 /// the mean of `|thigh × shin|` is this share of the mean `|thigh| |shin|` (about 3°).
 const FLEXION_SEEN: f64 = 0.05;
 
+/// The most (rad) [`flexion_twist`] turns a frame: a knee that seems to flex about an axis
+/// further than this from its frame's +y is not bending forward (a subject standing with
+/// straight knees, e.g. the Rigify idle take, where the little bend there is sideways put
+/// the thighs 95° and 187° off), so the reference pose's twist stays.
+const FLEXION_TWIST_MAX: f64 = std::f64::consts::FRAC_PI_4;
+
 /// Turns the human's thigh and shin frames (`offsets`, [`fk::Humanoid::frame_offsets`])
 /// about their bones so that the knee flexes about their +y axis, on average over the
 /// `picked` frames weighted by how bent the knee is (the mean of `thigh × shin` seen from
@@ -361,7 +367,10 @@ fn flexion_twist(
             continue;
         }
         // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to +y.
-        let theta = n.y.atan2(n.x) - std::f64::consts::FRAC_PI_2;
+        let theta = crate::feet::wrap(n.y.atan2(n.x) - std::f64::consts::FRAC_PI_2);
+        if theta.abs() > FLEXION_TWIST_MAX {
+            continue;
+        }
         offsets.insert(role, offset * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta));
     }
 }

@@ -739,7 +739,8 @@ fn planted_pose(
     Pose { quat: [q.w, q.i, q.j, q.k], pos }
 }
 
-fn wrap(a: f64) -> f64 {
+/// `a` (rad) wrapped into [−π, π).
+pub(crate) fn wrap(a: f64) -> f64 {
     (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
