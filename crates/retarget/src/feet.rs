@@ -290,7 +290,8 @@ impl RobotFoot {
     }
 }
 
-fn is_descendant(model: &Model, mut body: usize, ancestor: usize) -> bool {
+/// Whether `body` is `ancestor` or one of the bodies below it.
+pub(crate) fn is_descendant(model: &Model, mut body: usize, ancestor: usize) -> bool {
     loop {
         if body == ancestor {
             return true;

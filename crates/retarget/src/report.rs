@@ -576,16 +576,29 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
             .map(|(i, _)| i)
             .min_by(|&a, &b| data.xpos[a].z.total_cmp(&data.xpos[b].z).then(b.cmp(&a)))
     };
-    match (side(["left", "_l_", "_l"], "l_"), side(["right", "_r_", "_r"], "r_")) {
-        (Some(l), Some(r)) if l != r => Ok([l, r]),
+    let recognised =
+        crate::robot_roles::RobotRoles::recognise(model).map(|roles| roles.soles.map(|s| s.body));
+    match (side(["left", "_l_", "_l"], "l_"), side(["right", "_r_", "_r"], "r_"), recognised) {
+        // A named body above the recognised foot is an ankle link between the shin and the
+        // foot (Adam Lite's `anklePitchLeft`, over its `toeLeft`): the foot is the recognised
+        // one. (Planting that ankle link planted the shin, its tracked ancestor.)
+        (Some(l), Some(r), Ok([rl, rr])) if l != r => {
+            let foot = |named: usize, found: usize| {
+                if named != found && crate::feet::is_descendant(model, found, named) {
+                    found
+                } else {
+                    named
+                }
+            };
+            Ok([foot(l, rl), foot(r, rr)])
+        }
+        (Some(l), Some(r), Err(_)) if l != r => Ok([l, r]),
         // Names say nothing: the robot recogniser's feet (tree and geometry).
-        _ => match crate::robot_roles::RobotRoles::recognise(model) {
-            Ok(roles) => Ok(roles.soles.map(|s| s.body)),
-            Err(e) => Err(Error::Options(format!(
-                "cannot find the two foot bodies by name (ankle/foot, left/right) nor by \
-                 recognising the robot ({e}): name them"
-            ))),
-        },
+        (_, _, Ok(found)) => Ok(found),
+        (_, _, Err(e)) => Err(Error::Options(format!(
+            "cannot find the two foot bodies by name (ankle/foot, left/right) nor by \
+             recognising the robot ({e}): name them"
+        ))),
     }
 }
 
