@@ -125,24 +125,26 @@ pub struct RobotFoot {
     forward: Vector3<f64>,
     /// The foot body's world orientation at `qpos0`: standing flat.
     rest: UnitQuaternion<f64>,
-    /// The bottom corners of the sole's boxes, in the foot frame (lowest four at `qpos0`).
+    /// The sole's bottom points in the foot frame ([`bottom_points`] of each primitive):
+    /// where it stands on the floor.
     corners: Vec<Vector3<f64>>,
     /// The shin: target slot of the nearest ancestor body with a task, and the foot's
     /// orientation relative to it at `qpos0` (`shin⁻¹ ⊗ foot`).
     shin: Option<(usize, UnitQuaternion<f64>)>,
 }
 
-/// Sole corners higher than the lowest point by this much (m) are not held vertically;
+/// Sole bottom points higher than the lowest by this much (m) are not held vertically;
 /// lower ones are held the more, the lower they are.
 pub const CONTACT_PATCH: f64 = 0.01;
 
 /// A point of a planted sole: where it is in the foot (`point`, foot frame), where it stays
 /// (`at`, world), and the share of the contact weight that holds it horizontally and
-/// vertically. Every bottom corner of a box sole is held horizontally (so the foot neither
-/// slides nor turns, whatever tilt the robot's ankle can reach); vertically, the corners
-/// that touch the floor in the planted pose (four standing flat, two on the toes or the
-/// heel), fading out over [`CONTACT_PATCH`] above the lowest. A sole without boxes is held
-/// at its lowest point. The shares of one foot have a root sum of squares of 1 (per axis,
+/// vertically. Every bottom point of the sole ([`bottom_points`]: a box's corners, a bar's
+/// ends, a ball) is held horizontally (so the foot neither slides nor turns, whatever tilt
+/// the robot's ankle can reach); vertically, the points that touch the floor in the planted
+/// pose (four standing flat, two on the toes or the heel), fading out over
+/// [`CONTACT_PATCH`] above the lowest. A sole without bottom points is held at its lowest
+/// point. The shares of one foot have a root sum of squares of 1 (per axis,
 /// standing flat), so a foot's hold does not depend on how many points it has.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolePoint {
@@ -181,20 +183,7 @@ impl RobotFoot {
         let forward = data.xmat[body].transpose() * Vector3::x();
         let corners = sole
             .iter()
-            .filter(|(kind, _, _)| *kind == GeomType::Box)
-            .flat_map(|(_, s, rel)| {
-                let mut all: Vec<Vector3<f64>> = (0..8)
-                    .map(|k| {
-                        let sign = |bit: usize| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
-                        rel * nalgebra::Point3::new(sign(0) * s[0], sign(1) * s[1], sign(2) * s[2])
-                    })
-                    .map(|p| p.coords)
-                    .collect();
-                let rest = body_pose.rotation;
-                all.sort_by(|a, b| (rest * a).z.total_cmp(&(rest * b).z));
-                all.truncate(4);
-                all
-            })
+            .flat_map(|(kind, size, rel)| bottom_points(*kind, size, rel, &body_pose.rotation))
             .collect();
         let shin = shin.map(|(shin_body, shin_slot)| {
             let shin_rest = UnitQuaternion::from_matrix(&data.xmat[shin_body]);
@@ -216,9 +205,9 @@ impl RobotFoot {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The toe point in the foot frame: the middle of the two foremost bottom corners of a
-    /// box sole (holosoma measures skating at a toe body), else the sole's lowest point at
-    /// rest.
+    /// The toe point in the foot frame: the middle of the sole's two foremost bottom points
+    /// ([`bottom_points`]; holosoma measures skating at a toe body), else the sole's lowest
+    /// point at rest.
     #[must_use]
     pub fn toe_point(&self) -> Vector3<f64> {
         let mut corners = self.corners.clone();
@@ -287,6 +276,63 @@ impl RobotFoot {
     fn yaw(&self, rot: &UnitQuaternion<f64>) -> f64 {
         let f = rot * self.forward;
         f.y.atan2(f.x)
+    }
+}
+
+/// Where a sole primitive (`kind`, MuJoCo `size`, pose `rel` in the foot frame) stands on the
+/// floor when the foot stands as at `qpos0` (world orientation `rest`), in the foot frame: a
+/// box's four lowest corners; a capsule's, or a lying cylinder's, lowest point at each end
+/// (soles of two bars along the foot, as the T1's, Adam Lite's or the G1's URDF); a standing
+/// cylinder's lowest cap, four points on its rim (forward, back and to either side); a
+/// sphere's or an ellipsoid's lowest point (the G1 MJCFs' four corner balls). Other kinds
+/// stand nowhere.
+fn bottom_points(
+    kind: GeomType,
+    size: &[f64; 3],
+    rel: &Isometry3<f64>,
+    rest: &UnitQuaternion<f64>,
+) -> Vec<Vector3<f64>> {
+    // The world's up in the foot frame, and a point `p` of the geom's frame in the foot's.
+    let up = rest.inverse() * Vector3::z();
+    let at = |p: Vector3<f64>| (rel * nalgebra::Point3::from(p)).coords;
+    let axis = rel.rotation * Vector3::z();
+    // The unit vector across the geom's axis that points down the most.
+    let down_across = (-up + axis * axis.dot(&up)).try_normalize(1e-9);
+    match kind {
+        GeomType::Box => {
+            let mut all: Vec<Vector3<f64>> = (0..8)
+                .map(|k| {
+                    let sign = |bit: usize| if k & (1 << bit) == 0 { -1.0 } else { 1.0 };
+                    at(Vector3::new(sign(0) * size[0], sign(1) * size[1], sign(2) * size[2]))
+                })
+                .collect();
+            all.sort_by(|a, b| up.dot(a).total_cmp(&up.dot(b)));
+            all.truncate(4);
+            all
+        }
+        GeomType::Capsule => {
+            [-1.0, 1.0].map(|end| at(Vector3::new(0.0, 0.0, end * size[1])) - up * size[0]).to_vec()
+        }
+        GeomType::Cylinder if axis.dot(&up).abs() < std::f64::consts::FRAC_1_SQRT_2 => {
+            let Some(across) = down_across else { return Vec::new() };
+            [-1.0, 1.0]
+                .map(|end| at(Vector3::new(0.0, 0.0, end * size[1])) + across * size[0])
+                .to_vec()
+        }
+        GeomType::Cylinder => {
+            let cap = at(Vector3::new(0.0, 0.0, -size[1] * axis.dot(&up).signum()));
+            let forward = rest.inverse() * Vector3::x();
+            let Some(forward) = (forward - axis * axis.dot(&forward)).try_normalize(1e-9) else {
+                return vec![cap];
+            };
+            let side = axis.cross(&forward);
+            [forward, -forward, side, -side].map(|d| cap + d * size[0]).to_vec()
+        }
+        GeomType::Sphere | GeomType::Ellipsoid => {
+            let r = (rest * rel.rotation).to_rotation_matrix().into_inner();
+            vec![rel.translation.vector + rest.inverse() * support_offset(kind, size, &r)]
+        }
+        _ => Vec::new(),
     }
 }
 
@@ -568,13 +614,13 @@ fn swing_edges(planted: &[bool]) -> Vec<Option<(usize, usize)>> {
 type Planted = (Range<usize>, Vector3<f64>, f64);
 
 /// Moves the anchors of stance phases that overlap in time apart until the flat soles'
-/// footprints (their bottom corners at the anchors) are at least `gap` apart along one of the
+/// footprints (their bottom points at the anchors) are at least `gap` apart along one of the
 /// footprints' edge directions (the separating axis along which they are furthest apart, so
 /// the shortest way apart: sideways for feet side by side, forwards for one behind the
 /// other): each moves half the shortfall, along that axis. Separation along an axis bounds
 /// the true gap from below, so the result is conservative. A phase that
 /// overlaps several of the other foot's is moved for each (three sweeps settle chains).
-/// Soles without boxes have no footprint and are left alone.
+/// Soles without bottom points have no footprint and are left alone.
 fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2], gap: f64) {
     if left.corners.is_empty() || right.corners.is_empty() || gap.is_nan() {
         return;
@@ -767,6 +813,54 @@ mod tests {
             corners,
             shin: None,
         }
+    }
+
+    /// A foot on a free body at 5 cm, facing +x, with `geoms` (MJCF) as its sole.
+    fn foot_with(geoms: &str) -> RobotFoot {
+        let xml = format!(
+            r#"<mujoco><worldbody><body name="foot" pos="0 0 0.05"><freejoint/>{geoms}</body>
+               </worldbody></mujoco>"#
+        );
+        let model = Model::from_xml_str(&xml, None).unwrap();
+        RobotFoot::new(&model, 1, 1, 0, None).unwrap()
+    }
+
+    fn sorted(mut points: Vec<Vector3<f64>>) -> Vec<[f64; 3]> {
+        let r = |v: f64| (v * 1e9).round() / 1e9;
+        let mut out: Vec<[f64; 3]> = points.drain(..).map(|p| [r(p.x), r(p.y), r(p.z)]).collect();
+        out.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        out
+    }
+
+    #[test]
+    fn soles_of_bars_and_balls_stand_on_their_ends_and_balls() {
+        // Two capsule bars along the foot (the T1's), two lying cylinders (Adam Lite's, the
+        // G1 URDF's), four balls (the G1 MJCFs'): each stands on the four bottom points of
+        // its ends and balls, and its toe point is between the front two.
+        let bars = [
+            r#"<geom type="capsule" size="0.02 0.09" pos="0.03 0.03 -0.03" euler="0 90 0"/>
+               <geom type="capsule" size="0.02 0.09" pos="0.03 -0.03 -0.03" euler="0 90 0"/>"#,
+            r#"<geom type="cylinder" size="0.02 0.09" pos="0.03 0.03 -0.03" euler="0 90 0"/>
+               <geom type="cylinder" size="0.02 0.09" pos="0.03 -0.03 -0.03" euler="0 90 0"/>"#,
+            r#"<geom size="0.02" pos="-0.06 0.03 -0.03"/><geom size="0.02" pos="0.12 0.03 -0.03"/>
+               <geom size="0.02" pos="-0.06 -0.03 -0.03"/><geom size="0.02" pos="0.12 -0.03 -0.03"/>"#,
+        ];
+        let expected = sorted(
+            [(-0.06, -0.03), (-0.06, 0.03), (0.12, -0.03), (0.12, 0.03)]
+                .map(|(x, y)| Vector3::new(x, y, -0.05))
+                .to_vec(),
+        );
+        for sole in bars {
+            let foot = foot_with(sole);
+            assert_eq!(sorted(foot.corners.clone()), expected, "{sole}");
+            assert!((foot.toe_point() - Vector3::new(0.12, 0.0, -0.05)).norm() < 1e-9, "{sole}");
+        }
+        // A standing cylinder (a round sole) stands on its rim: front, back and both sides.
+        let foot = foot_with(r#"<geom type="cylinder" size="0.05 0.01" pos="0 0 -0.04"/>"#);
+        let rim = [(0.05, 0.0), (-0.05, 0.0), (0.0, 0.05), (0.0, -0.05)]
+            .map(|(x, y)| Vector3::new(x, y, -0.05))
+            .to_vec();
+        assert_eq!(sorted(foot.corners.clone()), sorted(rim));
     }
 
     #[test]
