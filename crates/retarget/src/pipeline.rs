@@ -379,11 +379,7 @@ impl<'a> Prepared<'a> {
             SolveMode::Gmr => 0,
         };
         let end = (range.end + passes).min(self.num_frames());
-        if matches!(self.options.mode, SolveMode::Plausible(_)) {
-            if let Some(start) = self.start_pose(first) {
-                solver.set_qpos(&start)?;
-            }
-        }
+        let plausible = matches!(self.options.mode, SolveMode::Plausible(_));
         let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
@@ -393,7 +389,11 @@ impl<'a> Prepared<'a> {
         // the self-collision rows: 1402 frames > 1 cm against 14.)
         for f in first..end {
             self.set_frame_tasks(&mut solver, f)?;
-            frames.push(solver.solve_frame(self.frame_targets(f), first_frame_dt(f == first, dt))?);
+            frames.push(if plausible && f == first {
+                solve_first_frame(self.model, &mut solver, &self.tracked, self.frame_targets(f))?
+            } else {
+                solver.solve_frame(self.frame_targets(f), first_frame_dt(f == first, dt))?
+            });
             reject_divergence(solver.qpos(), f)?;
             qpos.extend_from_slice(solver.qpos());
         }
@@ -445,15 +445,6 @@ impl<'a> Prepared<'a> {
         qpos.truncate((range.end - first) * nq);
         frames.truncate(range.end - first);
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
-    }
-
-    /// The start configuration at frame `f` ([`start_pose`]).
-    fn start_pose(&self, f: usize) -> Option<Vec<f64>> {
-        start_pose(
-            self.model,
-            &self.tracked,
-            self.targets.get(f * self.slots..(f + 1) * self.slots)?,
-        )
     }
 
     fn frame_targets(&self, f: usize) -> &[Pose] {
@@ -577,6 +568,53 @@ pub(crate) fn first_frame_dt(first: bool, dt: f64) -> f64 {
         0.0
     } else {
         dt
+    }
+}
+
+/// Solves the first frame of a solve (no previous frame: no speed limits) from the better of
+/// two starts ([`start_poses`]): `qpos0` at the root target turned to its heading, and not
+/// turned. The start decides which of several solutions a limb settles in for the rest of
+/// the clip (the T1's arms on the Bandai kick, which begins with the subject turned 90°:
+/// from the turned start both wrists stayed 90–130° off their targets to the end, mean
+/// rotation error 38.8° against 18.3° from the other). The better is the one with the
+/// smaller error at the end of the frame's solve; it is solved again from its start, so the
+/// solver is left as if it had been the only one.
+pub(crate) fn solve_first_frame(
+    model: &Model,
+    solver: &mut Solver<'_>,
+    tracked: &[(usize, usize)],
+    targets: &[Pose],
+) -> Result<FrameDiagnostics, Error> {
+    let starts = start_poses(model, tracked, targets);
+    let mut best = (f64::INFINITY, 0);
+    if starts.len() > 1 {
+        for (k, start) in starts.iter().enumerate() {
+            solver.set_qpos(start)?;
+            let error = solver.solve_frame(targets, 0.0)?.error;
+            if error < best.0 {
+                best = (error, k);
+            }
+        }
+    }
+    if let Some(start) = starts.get(best.1) {
+        solver.set_qpos(start)?;
+    }
+    solver.solve_frame(targets, 0.0)
+}
+
+/// The starts of [`solve_first_frame`]: [`start_pose`], and the same not turned when that
+/// differs.
+fn start_poses(model: &Model, tracked: &[(usize, usize)], targets: &[Pose]) -> Vec<Vec<f64>> {
+    let Some(turned) = start_pose(model, tracked, targets) else { return Vec::new() };
+    let mut straight = model.qpos0.clone();
+    if let Some(root) = model.joints.iter().find(|j| j.kind == JointType::Free) {
+        let a = root.qpos_adr;
+        straight[a..a + 2].copy_from_slice(&turned[a..a + 2]);
+    }
+    if straight == turned {
+        vec![turned]
+    } else {
+        vec![turned, straight]
     }
 }
 

@@ -35,7 +35,7 @@ use crate::lie::Pose;
 use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
 use crate::pipeline::{
-    build_solver, finite_pose, start_pose, task_specs, ClipDiagnostics, PlausibleOptions,
+    build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, PlausibleOptions,
     RetargetOptions, SolveMode,
 };
 use crate::report::{QualityReport, ReportOptions};
@@ -596,12 +596,11 @@ impl Stream {
         let plausible = matches!(self.options.mode, SolveMode::Plausible(_));
         let (targets, tracked, dt, index) = (&self.targets, &self.tracked, self.dt, self.frames);
         let diag = self.solver.with_dependent_mut(|model, solver| {
-            if first && plausible {
-                if let Some(start) = start_pose(model, tracked, targets) {
-                    solver.set_qpos(&start)?;
-                }
-            }
-            let diag = solver.solve_frame(targets, crate::pipeline::first_frame_dt(first, dt))?;
+            let diag = if first && plausible {
+                solve_first_frame(model, solver, tracked, targets)?
+            } else {
+                solver.solve_frame(targets, crate::pipeline::first_frame_dt(first, dt))?
+            };
             crate::pipeline::reject_divergence(solver.qpos(), index)?;
             Ok::<_, Error>(diag)
         })?;
