@@ -165,8 +165,13 @@ pub struct Posture {
 pub struct HumanBody {
     /// Human body (joint) name per role.
     pub joints: BTreeMap<Role, String>,
-    /// `q_joint⁻¹ ⊗ C_h` per role ([`fk::Humanoid::frame_offsets`]).
+    /// `q_joint⁻¹ ⊗ C_h` per role ([`fk::Humanoid::frame_offsets`]), limbs turned about
+    /// their bones by the knees' and elbows' flexion axes ([`flexion_twist`]).
     pub frame_offsets: BTreeMap<Role, UnitQuaternion<f64>>,
+    /// The turn about the bone that [`flexion_twist`] gave each arm role's frame (the last
+    /// factor of its `frame_offsets` entry): undone for a robot whose arms do not flex
+    /// forward at `qpos0` ([`HumanBody::for_robot`]).
+    pub arm_twists: BTreeMap<Role, UnitQuaternion<f64>>,
     /// Path length from the pelvis point (midway between the hip joints) to each role's joint
     /// through the role joints ([`module docs`](self)); the pelvis's entry is the standing hip
     /// height (thigh + shin + ankle height).
@@ -198,6 +203,7 @@ impl HumanBody {
         HumanBody {
             joints,
             frame_offsets,
+            arm_twists: BTreeMap::new(),
             paths: paths(&points, ankle),
             postures: vec![Posture {
                 frames: fk::canonical_frames(&points),
@@ -240,8 +246,14 @@ impl HumanBody {
                 *offset *= flat_foot(motion, b, *offset, ground + ankle + FLAT_FOOT);
             }
         }
+        let mut arm_twists = BTreeMap::new();
         for side in [Side::Left, Side::Right] {
-            flexion_twist(motion, &index, &mut frame_offsets, &picked, side);
+            for limb in [Limb::Leg, Limb::Arm] {
+                let twists = flexion_twist(motion, &index, &mut frame_offsets, &picked, side, limb);
+                if limb == Limb::Arm {
+                    arm_twists.extend(twists);
+                }
+            }
         }
         let mut sums: BTreeMap<Role, f64> = BTreeMap::new();
         let mut postures = Vec::with_capacity(picked.len());
@@ -282,6 +294,7 @@ impl HumanBody {
         Ok(HumanBody {
             joints: kept,
             frame_offsets,
+            arm_twists,
             paths,
             postures,
             ground,
@@ -310,68 +323,154 @@ fn flat_foot(
     UnitQuaternion::rotation_between(&Vector3::z(), &up).unwrap_or_default()
 }
 
-/// The leg roles whose canonical frames [`flexion_twist`] turns about their bones: those
-/// [`limb_frames`] turns on the robot, but for the arms (measured: turning the human's upper
-/// arm by the elbow's flexion axis moves GMR's solve on ToddlerBot's sideways elbows onto a
-/// branch with the shoulder at its limits from the first frame).
-const FLEXION_TWISTED: [Part; 2] = [Part::Thigh, Part::Shin];
+/// A limb whose frames [`flexion_twist`] turns about their bones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Limb {
+    Leg,
+    Arm,
+}
+
+impl Limb {
+    /// Its three joints, the middle one the hinge (knee, elbow).
+    fn chain(self) -> [Part; 3] {
+        match self {
+            Limb::Leg => [Part::Thigh, Part::Shin, Part::Foot],
+            Limb::Arm => [Part::UpperArm, Part::Forearm, Part::Hand],
+        }
+    }
+
+    /// The frame axis it flexes about: a knee about +y (the shin goes back), an elbow about
+    /// −y (the forearm comes forward), as [`limb_frames`] turns the robot's.
+    fn y_sign(self) -> f64 {
+        match self {
+            Limb::Leg => 1.0,
+            Limb::Arm => -1.0,
+        }
+    }
+}
 
 /// A knee counts as bent enough to say which way it flexes when, over the sampled frames,
-/// the mean of `|thigh × shin|` is this share of the mean `|thigh| |shin|` (about 3°).
+/// the mean of `|thigh × shin|` is this share of the mean `|thigh| |shin|` (about 3°); an
+/// elbow likewise.
 const FLEXION_SEEN: f64 = 0.05;
 
-/// The most (rad) [`flexion_twist`] turns a frame: a knee that seems to flex about an axis
-/// further than this from its frame's +y is not bending forward (a subject standing with
-/// straight knees, e.g. the Rigify idle take, where the little bend there is sideways put
-/// the thighs 95° and 187° off), so the reference pose's twist stays.
+/// The most (rad) [`flexion_twist`] turns a leg's frames: a knee that seems to flex about an
+/// axis further than this from its frame's +y is not bending forward (a subject standing
+/// with straight knees, e.g. the Rigify idle take, where the little bend there is sideways
+/// put the thighs 95° and 187° off), so the reference pose's twist stays. An arm's turn is
+/// not bounded: a reference pose's arms may be turned any way (the Bandai kick's left
+/// upper arm: 95°).
 const FLEXION_TWIST_MAX: f64 = std::f64::consts::FRAC_PI_4;
 
-/// Turns the human's thigh and shin frames (`offsets`, [`fk::Humanoid::frame_offsets`])
-/// about their bones so that the knee flexes about their +y axis, on average over the
-/// `picked` frames weighted by how bent the knee is (the mean of `thigh × shin` seen from
-/// each frame). fk's limb frames take their twist from the body's forward direction in the
-/// reference pose, so they carry whatever hip rotation the subject had there (8–17° on the
-/// LAFAN1 takes); the robot's are turned by its knee axis ([`limb_frames`]), so both sides
-/// then agree on the flexion axis, and the robot's thighs and shins are asked for turns
-/// they can make (the G1's mean hip and knee rotation errors in GMR's solve of the jumps:
-/// 15° and 13° before, 9° and 5° after).
+/// Turns the human's frames of a limb (`offsets`, [`fk::Humanoid::frame_offsets`]) about
+/// their bones so that the middle joint flexes about their ±y axis ([`Limb::y_sign`]), on
+/// average over the `picked` frames weighted by how bent it is (the mean of `upper × lower`
+/// seen from each frame); the hand takes the forearm's turn. fk's limb frames take their
+/// twist from the body's forward direction in the reference pose, so they carry whatever
+/// rotation the subject's hip or shoulder had there (8–17° at the hips on the LAFAN1 takes;
+/// the arms of a reference frame taken mid-motion, as Bandai's, anything); the robot's are
+/// turned by its knee and elbow axes ([`limb_frames`]), so both sides then agree on the
+/// flexion axis, and the robot's limbs are asked for turns they can make. Measured, mean
+/// rotation error on the G1 (GMR's solve): the jumps' hips and knees 15° and 13° before the
+/// legs were turned, 9° and 5° after; over all bodies, after the arms were turned too, the
+/// derived config on the LAFAN1 walk 7.0° → 4.4°, the CMU 131_03 take 10.3° → 4.3°, the
+/// Bandai dance 20.5° → 6.1°. Returns the turn given to each role.
 fn flexion_twist(
     motion: &HumanMotion,
     index: &dyn Fn(Role) -> Option<usize>,
     offsets: &mut BTreeMap<Role, UnitQuaternion<f64>>,
     picked: &[usize],
     side: Side,
-) {
-    let chain = [Part::Thigh, Part::Shin, Part::Foot].map(|p| index(Role::of(p, side)));
-    let [Some(hip), Some(knee), Some(ankle)] = chain else { return };
+    limb: Limb,
+) -> BTreeMap<Role, UnitQuaternion<f64>> {
+    let mut turned = BTreeMap::new();
+    let roles = limb.chain().map(|p| Role::of(p, side));
+    let [Some(top), Some(middle), Some(end)] = roles.map(index) else { return turned };
     let bones: Vec<(usize, Vector3<f64>, Vector3<f64>)> = picked
         .iter()
         .map(|&f| {
-            let thigh = motion.position(f, knee) - motion.position(f, hip);
-            (f, thigh, motion.position(f, ankle) - motion.position(f, knee))
+            let upper = motion.position(f, middle) - motion.position(f, top);
+            (f, upper, motion.position(f, end) - motion.position(f, middle))
         })
         .filter(|(_, a, b)| a.iter().chain(b.iter()).all(|x| x.is_finite()))
         .collect();
     let lengths: f64 = bones.iter().map(|(_, a, b)| a.norm() * b.norm()).sum();
-    for part in FLEXION_TWISTED {
-        let role = Role::of(part, side);
+    let mut middle_turn = None;
+    for (k, role) in roles.into_iter().enumerate() {
         let (Some(body), Some(offset)) = (index(role), offsets.get(&role).copied()) else {
             continue;
         };
-        let n: Vector3<f64> = bones
-            .iter()
-            .map(|(f, a, b)| (motion.orientation(*f, body) * offset).inverse() * a.cross(b))
-            .sum();
-        let seen = n.x.hypot(n.y) > FLEXION_SEEN * lengths;
-        if !seen {
-            continue;
+        let theta = if k == 2 {
+            // The foot keeps its own frame (flat on the floor); the hand turns with the
+            // forearm.
+            match (limb, middle_turn) {
+                (Limb::Arm, Some(theta)) => theta,
+                _ => continue,
+            }
+        } else {
+            let n: Vector3<f64> = bones
+                .iter()
+                .map(|(f, a, b)| (motion.orientation(*f, body) * offset).inverse() * a.cross(b))
+                .sum();
+            if n.x.hypot(n.y) <= FLEXION_SEEN * lengths {
+                continue;
+            }
+            // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to ±y.
+            let theta =
+                crate::feet::wrap(n.y.atan2(n.x) - limb.y_sign() * std::f64::consts::FRAC_PI_2);
+            if limb == Limb::Leg && theta.abs() > FLEXION_TWIST_MAX {
+                continue;
+            }
+            theta
+        };
+        if k == 1 {
+            middle_turn = Some(theta);
         }
-        // Turning the frame by θ about z brings n (at angle atan2(n.y, n.x)) to +y.
-        let theta = crate::feet::wrap(n.y.atan2(n.x) - std::f64::consts::FRAC_PI_2);
-        if theta.abs() > FLEXION_TWIST_MAX {
-            continue;
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta);
+        offsets.insert(role, offset * turn);
+        turned.insert(role, turn);
+    }
+    turned
+}
+
+impl HumanBody {
+    /// This human as a robot whose limb frames are `frames` ([`limb_frames`]) is matched
+    /// with: unchanged, but for a robot whose arms do not flex forward at `qpos0` (frames
+    /// turned more than 45° about the upper arm), whose arms keep fk's frames. Measured: on
+    /// ToddlerBot, whose elbows bend sideways at `qpos0`, the turned arms twisted its torso
+    /// 40° towards them (rotation error 20.9° → 31.6° on the LAFAN1 walk; better on the
+    /// jumps, 21.6° → 17.2°). Taking the other side of its elbow's range as flexion instead
+    /// gives 22.6° and 17.4°: its flexion sense, not the turn, may be what is wrong there.
+    #[must_use]
+    pub fn for_robot(
+        &self,
+        frames: &BTreeMap<Role, UnitQuaternion<f64>>,
+        roles: &RobotRoles,
+    ) -> HumanBody {
+        let canonical = roles.canonical_frames();
+        let sideways = [Side::Left, Side::Right].iter().any(|&side| {
+            let arm = Role::of(Part::UpperArm, side);
+            match (canonical.get(&arm), frames.get(&arm)) {
+                (Some(c), Some(f)) => c.angle_to(f) > std::f64::consts::FRAC_PI_4,
+                _ => false,
+            }
+        });
+        let mut out = self.clone();
+        if !sideways {
+            return out;
         }
-        offsets.insert(role, offset * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta));
+        for (role, turn) in &self.arm_twists {
+            if let Some(offset) = out.frame_offsets.get_mut(role) {
+                *offset *= turn.inverse();
+            }
+            for posture in &mut out.postures {
+                if let Some(frame) = posture.frames.get_mut(role) {
+                    *frame *= turn.inverse();
+                }
+            }
+        }
+        out.arm_twists.clear();
+        out
     }
 }
 
@@ -934,6 +1033,7 @@ pub fn derive(
     source: &str,
 ) -> Result<IkConfig, Error> {
     let robot = robot_side(model, roles);
+    let human = &human.for_robot(&robot.frames, roles);
     let root_scale = match (robot.paths.get(&Role::Pelvis), human.paths.get(&Role::Pelvis)) {
         (Some(r), Some(h)) if *h > 0.0 => r / h,
         _ => 1.0,
@@ -977,6 +1077,7 @@ pub fn bind(
 ) -> Result<IkConfig, Error> {
     let canonical = HumanBody::canonical();
     let robot = robot_side(model, roles);
+    let human = &human.for_robot(&robot.frames, roles);
     let frames = &robot.frames;
     let mut data = Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
@@ -1499,15 +1600,58 @@ mod tests {
         let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
             [(Role::LeftThigh, twist), (Role::LeftShin, twist)].into_iter().collect();
         let picked: Vec<usize> = (0..frames).collect();
-        flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left);
+        flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left, Limb::Leg);
         for role in [Role::LeftThigh, Role::LeftShin] {
             assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
         }
         // Straight all along: nothing says how the knee flexes.
         let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
             [(Role::LeftThigh, twist)].into_iter().collect();
-        flexion_twist(&motion, &index, &mut offsets, &[0], Side::Left);
+        flexion_twist(&motion, &index, &mut offsets, &[0], Side::Left, Limb::Leg);
         assert!((offsets[&Role::LeftThigh].angle() - 30f64.to_radians()).abs() < 1e-12);
+    }
+
+    /// An arm whose frames carry a 100° twist about the bone (a reference pose taken
+    /// mid-motion), the elbow flexing forward (the forearm turns about world −y): all three
+    /// frames are turned back, the hand by the forearm's turn, and the turns are returned.
+    #[test]
+    fn flexion_twist_turns_the_arm_frames_to_the_elbow_axis() {
+        let names = ["shoulder", "elbow", "wrist"].map(str::to_owned).to_vec();
+        let frames = 20;
+        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
+        for f in 0..frames {
+            let bend = UnitQuaternion::from_axis_angle(&-Vector3::y_axis(), f as f64 * 0.06);
+            let elbow = Vector3::new(0.0, 0.2, 1.1);
+            positions.extend([
+                Vector3::new(0.0, 0.2, 1.4),
+                elbow,
+                elbow + bend * Vector3::new(0.0, 0.0, -0.25),
+            ]);
+            orientations.extend([UnitQuaternion::identity(), bend, bend]);
+        }
+        let motion = HumanMotion {
+            fps: 30.0,
+            body_names: names,
+            num_frames: frames,
+            positions,
+            orientations,
+        };
+        let index = |role: Role| match role {
+            Role::LeftUpperArm => Some(0),
+            Role::LeftForearm => Some(1),
+            Role::LeftHand => Some(2),
+            _ => None,
+        };
+        let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 100f64.to_radians());
+        let arm = [Role::LeftUpperArm, Role::LeftForearm, Role::LeftHand];
+        let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
+            arm.iter().map(|&r| (r, twist)).collect();
+        let picked: Vec<usize> = (0..frames).collect();
+        let turns = flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left, Limb::Arm);
+        for role in arm {
+            assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
+            assert!((turns[&role] * twist).angle() < 1e-9, "{role}: {:?}", turns[&role]);
+        }
     }
 
     #[test]
