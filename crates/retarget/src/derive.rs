@@ -1563,43 +1563,56 @@ mod tests {
         assert!(sole_fit(&[sole], &human, Role::RightFoot, 1.0, 1.0, prior).is_none());
     }
 
+    /// A limb of three joints over 20 frames: the top one at `top`, the middle one `upper`
+    /// below it, the end one `lower` below that, bent by `step` more each frame about
+    /// `axis` (world); the middle and end joints turn with the bend.
+    fn bending_limb(
+        top: Vector3<f64>,
+        (upper, lower): (f64, f64),
+        axis: nalgebra::Unit<Vector3<f64>>,
+        step: f64,
+        index: &dyn Fn(Role) -> Option<usize>,
+        roles: [Role; 3],
+    ) -> HumanMotion {
+        let frames = 20;
+        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
+        for f in 0..frames {
+            let bend = UnitQuaternion::from_axis_angle(&axis, f as f64 * step);
+            let middle = top - Vector3::new(0.0, 0.0, upper);
+            positions.extend([top, middle, middle + bend * Vector3::new(0.0, 0.0, -lower)]);
+            orientations.extend([UnitQuaternion::identity(), bend, bend]);
+        }
+        assert_eq!(roles.map(index), [Some(0), Some(1), Some(2)]);
+        HumanMotion {
+            fps: 30.0,
+            body_names: roles.map(|r| r.name().to_owned()).to_vec(),
+            num_frames: frames,
+            positions,
+            orientations,
+        }
+    }
+
     /// A leg whose thigh and shin frames carry a 30° twist about the bone (as fk's do when
     /// the subject's hip was turned in the reference pose), walking with the knee bending
     /// about world +y: the twist is taken out, so the knee flexes about the frames' +y. A
     /// leg that never bends is left as it is.
     #[test]
     fn flexion_twist_turns_thigh_and_shin_frames_to_the_knee_axis() {
-        let names = ["hip", "knee", "ankle"].map(str::to_owned).to_vec();
-        let frames = 20;
-        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
-        for f in 0..frames {
-            // The knee bends backward (the shin turns about +y) by 0..60°.
-            let bend = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), f as f64 * 0.05);
-            let knee = Vector3::new(0.0, 0.1, 0.5);
-            positions.extend([
-                Vector3::new(0.0, 0.1, 0.9),
-                knee,
-                knee + bend * Vector3::new(0.0, 0.0, -0.4),
-            ]);
-            orientations.extend([UnitQuaternion::identity(), bend, bend]);
-        }
-        let motion = HumanMotion {
-            fps: 30.0,
-            body_names: names,
-            num_frames: frames,
-            positions,
-            orientations,
-        };
-        let index = |role: Role| match role {
-            Role::LeftThigh => Some(0),
-            Role::LeftShin => Some(1),
-            Role::LeftFoot => Some(2),
-            _ => None,
-        };
+        let leg = [Role::LeftThigh, Role::LeftShin, Role::LeftFoot];
+        let index = |role: Role| leg.iter().position(|&r| r == role);
+        // The knee bends backward (the shin turns about +y) by 0..54°.
+        let motion = bending_limb(
+            Vector3::new(0.0, 0.1, 0.9),
+            (0.4, 0.4),
+            Vector3::y_axis(),
+            0.05,
+            &index,
+            leg,
+        );
         let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 30f64.to_radians());
         let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
             [(Role::LeftThigh, twist), (Role::LeftShin, twist)].into_iter().collect();
-        let picked: Vec<usize> = (0..frames).collect();
+        let picked: Vec<usize> = (0..motion.num_frames).collect();
         flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left, Limb::Leg);
         for role in [Role::LeftThigh, Role::LeftShin] {
             assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
@@ -1616,37 +1629,20 @@ mod tests {
     /// frames are turned back, the hand by the forearm's turn, and the turns are returned.
     #[test]
     fn flexion_twist_turns_the_arm_frames_to_the_elbow_axis() {
-        let names = ["shoulder", "elbow", "wrist"].map(str::to_owned).to_vec();
-        let frames = 20;
-        let (mut positions, mut orientations) = (Vec::new(), Vec::new());
-        for f in 0..frames {
-            let bend = UnitQuaternion::from_axis_angle(&-Vector3::y_axis(), f as f64 * 0.06);
-            let elbow = Vector3::new(0.0, 0.2, 1.1);
-            positions.extend([
-                Vector3::new(0.0, 0.2, 1.4),
-                elbow,
-                elbow + bend * Vector3::new(0.0, 0.0, -0.25),
-            ]);
-            orientations.extend([UnitQuaternion::identity(), bend, bend]);
-        }
-        let motion = HumanMotion {
-            fps: 30.0,
-            body_names: names,
-            num_frames: frames,
-            positions,
-            orientations,
-        };
-        let index = |role: Role| match role {
-            Role::LeftUpperArm => Some(0),
-            Role::LeftForearm => Some(1),
-            Role::LeftHand => Some(2),
-            _ => None,
-        };
-        let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 100f64.to_radians());
         let arm = [Role::LeftUpperArm, Role::LeftForearm, Role::LeftHand];
+        let index = |role: Role| arm.iter().position(|&r| r == role);
+        let motion = bending_limb(
+            Vector3::new(0.0, 0.2, 1.4),
+            (0.3, 0.25),
+            -Vector3::y_axis(),
+            0.06,
+            &index,
+            arm,
+        );
+        let twist = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 100f64.to_radians());
         let mut offsets: BTreeMap<Role, UnitQuaternion<f64>> =
             arm.iter().map(|&r| (r, twist)).collect();
-        let picked: Vec<usize> = (0..frames).collect();
+        let picked: Vec<usize> = (0..motion.num_frames).collect();
         let turns = flexion_twist(&motion, &index, &mut offsets, &picked, Side::Left, Limb::Arm);
         for role in arm {
             assert!(offsets[&role].angle() < 1e-9, "{role}: {:?}", offsets[&role]);
