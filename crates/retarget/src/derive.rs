@@ -166,9 +166,9 @@ pub struct HumanBody {
     /// Human body (joint) name per role.
     pub joints: BTreeMap<Role, String>,
     /// `q_joint⁻¹ ⊗ C_h` per role ([`fk::Humanoid::frame_offsets`]), limbs turned about
-    /// their bones by the knees' and elbows' flexion axes ([`flexion_twist`]).
+    /// their bones by the knees' and elbows' flexion axes (`flexion_twist`).
     pub frame_offsets: BTreeMap<Role, UnitQuaternion<f64>>,
-    /// The turn about the bone that [`flexion_twist`] gave each arm role's frame (the last
+    /// The turn about the bone that `flexion_twist` gave each arm role's frame (the last
     /// factor of its `frame_offsets` entry): undone for a robot whose arms do not flex
     /// forward at `qpos0` ([`HumanBody::for_robot`]).
     pub arm_twists: BTreeMap<Role, UnitQuaternion<f64>>,
@@ -323,7 +323,7 @@ fn flat_foot(
     UnitQuaternion::rotation_between(&Vector3::z(), &up).unwrap_or_default()
 }
 
-/// A limb whose frames [`flexion_twist`] turns about their bones.
+/// A limb whose frames `flexion_twist` turns about their bones.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Limb {
     Leg,
@@ -340,7 +340,7 @@ impl Limb {
     }
 
     /// The frame axis it flexes about: a knee about +y (the shin goes back), an elbow about
-    /// −y (the forearm comes forward), as [`limb_frames`] turns the robot's.
+    /// −y (the forearm comes forward), as `limb_frames` turns the robot's.
     fn y_sign(self) -> f64 {
         match self {
             Limb::Leg => 1.0,
@@ -354,7 +354,7 @@ impl Limb {
 /// elbow likewise.
 const FLEXION_SEEN: f64 = 0.05;
 
-/// The most (rad) [`flexion_twist`] turns a leg's frames: a knee that seems to flex about an
+/// The most (rad) `flexion_twist` turns a leg's frames: a knee that seems to flex about an
 /// axis further than this from its frame's +y is not bending forward (a subject standing
 /// with straight knees, e.g. the Rigify idle take, where the little bend there is sideways
 /// put the thighs 95° and 187° off), so the reference pose's twist stays. An arm's turn is
@@ -369,7 +369,7 @@ const FLEXION_TWIST_MAX: f64 = std::f64::consts::FRAC_PI_4;
 /// twist from the body's forward direction in the reference pose, so they carry whatever
 /// rotation the subject's hip or shoulder had there (8–17° at the hips on the LAFAN1 takes;
 /// the arms of a reference frame taken mid-motion, as Bandai's, anything); the robot's are
-/// turned by its knee and elbow axes ([`limb_frames`]), so both sides then agree on the
+/// turned by its knee and elbow axes (`limb_frames`), so both sides then agree on the
 /// flexion axis, and the robot's limbs are asked for turns they can make. Measured, mean
 /// rotation error on the G1 (GMR's solve): the jumps' hips and knees 15° and 13° before the
 /// legs were turned, 9° and 5° after; over all bodies, after the arms were turned too, the
@@ -434,7 +434,7 @@ fn flexion_twist(
 }
 
 impl HumanBody {
-    /// This human as a robot whose limb frames are `frames` ([`limb_frames`]) is matched
+    /// This human as a robot whose limb frames are `frames` (`limb_frames`) is matched
     /// with: unchanged, but for a robot whose arms do not flex forward at `qpos0` (frames
     /// turned more than 45° about the upper arm), whose arms keep fk's frames. Measured: on
     /// ToddlerBot, whose elbows bend sideways at `qpos0`, the turned arms twisted its torso
@@ -808,7 +808,7 @@ struct RobotSide {
     origins: BTreeMap<Role, Vector3<f64>>,
     /// Knee and elbow hinges, by the shin / forearm role.
     hinges: BTreeMap<Role, MiddleHinge>,
-    /// The canonical frames used ([`limb_frames`]).
+    /// The canonical frames used (`limb_frames`).
     frames: BTreeMap<Role, UnitQuaternion<f64>>,
     /// Per foot role, its sole's primitives ([`sole_geoms`]).
     soles: BTreeMap<Role, Vec<SoleGeom>>,

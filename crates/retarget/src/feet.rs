@@ -125,7 +125,7 @@ pub struct RobotFoot {
     forward: Vector3<f64>,
     /// The foot body's world orientation at `qpos0`: standing flat.
     rest: UnitQuaternion<f64>,
-    /// The sole's bottom points in the foot frame ([`bottom_points`] of each primitive):
+    /// The sole's bottom points in the foot frame (`bottom_points` of each primitive):
     /// where it stands on the floor.
     corners: Vec<Vector3<f64>>,
     /// The shin: target slot of the nearest ancestor body with a task, and the foot's
@@ -139,7 +139,7 @@ pub const CONTACT_PATCH: f64 = 0.01;
 
 /// A point of a planted sole: where it is in the foot (`point`, foot frame), where it stays
 /// (`at`, world), and the share of the contact weight that holds it horizontally and
-/// vertically. Every bottom point of the sole ([`bottom_points`]: a box's corners, a bar's
+/// vertically. Every bottom point of the sole (`bottom_points`: a box's corners, a bar's
 /// ends, a ball) is held horizontally (so the foot neither slides nor turns, whatever tilt
 /// the robot's ankle can reach); vertically, the points that touch the floor in the planted
 /// pose (four standing flat, two on the toes or the heel), fading out over
@@ -206,7 +206,7 @@ impl RobotFoot {
     }
 
     /// The toe point in the foot frame: the middle of the sole's two foremost bottom points
-    /// ([`bottom_points`]; holosoma measures skating at a toe body), else the sole's lowest
+    /// (`bottom_points`; holosoma measures skating at a toe body), else the sole's lowest
     /// point at rest.
     #[must_use]
     pub fn toe_point(&self) -> Vector3<f64> {
