@@ -76,6 +76,7 @@
 //! canonical one). Binding the role-named config of a robot gives exactly the config derived
 //! for that skeleton directly.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -170,7 +171,7 @@ pub struct HumanBody {
     pub frame_offsets: BTreeMap<Role, UnitQuaternion<f64>>,
     /// The turn about the bone that `flexion_twist` gave each arm role's frame (the last
     /// factor of its `frame_offsets` entry): undone for a robot whose arms do not flex
-    /// forward at `qpos0` ([`HumanBody::for_robot`]).
+    /// forward at `qpos0` (`HumanBody::for_robot`).
     pub arm_twists: BTreeMap<Role, UnitQuaternion<f64>>,
     /// Path length from the pelvis point (midway between the hip joints) to each role's joint
     /// through the role joints ([`module docs`](self)); the pelvis's entry is the standing hip
@@ -434,31 +435,18 @@ fn flexion_twist(
 }
 
 impl HumanBody {
-    /// This human as a robot whose limb frames are `frames` (`limb_frames`) is matched
-    /// with: unchanged, but for a robot whose arms do not flex forward at `qpos0` (frames
-    /// turned more than 45° about the upper arm), whose arms keep fk's frames. Measured: on
-    /// ToddlerBot, whose elbows bend sideways at `qpos0`, the turned arms twisted its torso
-    /// 40° towards them (rotation error 20.9° → 31.6° on the LAFAN1 walk; better on the
-    /// jumps, 21.6° → 17.2°). Taking the other side of its elbow's range as flexion instead
-    /// gives 22.6° and 17.4°: its flexion sense, not the turn, may be what is wrong there.
-    #[must_use]
-    pub fn for_robot(
-        &self,
-        frames: &BTreeMap<Role, UnitQuaternion<f64>>,
-        roles: &RobotRoles,
-    ) -> HumanBody {
-        let canonical = roles.canonical_frames();
-        let sideways = [Side::Left, Side::Right].iter().any(|&side| {
-            let arm = Role::of(Part::UpperArm, side);
-            match (canonical.get(&arm), frames.get(&arm)) {
-                (Some(c), Some(f)) => c.angle_to(f) > std::f64::consts::FRAC_PI_4,
-                _ => false,
-            }
-        });
-        let mut out = self.clone();
-        if !sideways {
-            return out;
+    /// This human as `robot` is matched with: itself, but for a robot whose arms do not flex
+    /// forward at `qpos0` ([`RobotSide::arms_sideways`]), whose arms keep fk's frames (the
+    /// `arm_twists` undone). Measured: on ToddlerBot, whose elbows bend sideways at `qpos0`,
+    /// the turned arms twisted its torso 40° towards them (rotation error 20.9° → 31.6° on the
+    /// LAFAN1 walk; better on the jumps, 21.6° → 17.2°). Taking the other side of its elbow's
+    /// range as flexion instead gives 22.6° and 17.4°: its flexion sense, not the turn, may be
+    /// what is wrong there.
+    fn for_robot(&self, robot: &RobotSide) -> Cow<'_, HumanBody> {
+        if !robot.arms_sideways {
+            return Cow::Borrowed(self);
         }
+        let mut out = self.clone();
         for (role, turn) in &self.arm_twists {
             if let Some(offset) = out.frame_offsets.get_mut(role) {
                 *offset *= turn.inverse();
@@ -470,7 +458,7 @@ impl HumanBody {
             }
         }
         out.arm_twists.clear();
-        out
+        Cow::Owned(out)
     }
 }
 
@@ -810,6 +798,9 @@ struct RobotSide {
     hinges: BTreeMap<Role, MiddleHinge>,
     /// The canonical frames used (`limb_frames`).
     frames: BTreeMap<Role, UnitQuaternion<f64>>,
+    /// Whether its arms do not flex forward at `qpos0`: `limb_frames` turned an upper arm's
+    /// frame more than 45° from its canonical one (ToddlerBot's sideways elbows).
+    arms_sideways: bool,
     /// Per foot role, its sole's primitives ([`sole_geoms`]).
     soles: BTreeMap<Role, Vec<SoleGeom>>,
 }
@@ -845,6 +836,14 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
             Some((*role, frames.get(role)?.inverse() * (data.xpos.get(r.body)? - r.point)))
         })
         .collect();
+    let canonical = roles.canonical_frames();
+    let arms_sideways = [Side::Left, Side::Right].iter().any(|&side| {
+        let arm = Role::of(Part::UpperArm, side);
+        match (canonical.get(&arm), frames.get(&arm)) {
+            (Some(c), Some(f)) => c.angle_to(f) > std::f64::consts::FRAC_PI_4,
+            _ => false,
+        }
+    });
     RobotSide {
         bodies,
         paths: paths(&points, ankle.max(0.0)),
@@ -853,6 +852,7 @@ fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
         hinges,
         soles: sole_geoms(model, &data, roles, &frames),
         frames,
+        arms_sideways,
     }
 }
 
@@ -1033,7 +1033,7 @@ pub fn derive(
     source: &str,
 ) -> Result<IkConfig, Error> {
     let robot = robot_side(model, roles);
-    let human = &human.for_robot(&robot.frames, roles);
+    let human = &*human.for_robot(&robot);
     let root_scale = match (robot.paths.get(&Role::Pelvis), human.paths.get(&Role::Pelvis)) {
         (Some(r), Some(h)) if *h > 0.0 => r / h,
         _ => 1.0,
@@ -1077,7 +1077,7 @@ pub fn bind(
 ) -> Result<IkConfig, Error> {
     let canonical = HumanBody::canonical();
     let robot = robot_side(model, roles);
-    let human = &human.for_robot(&robot.frames, roles);
+    let human = &*human.for_robot(&robot);
     let frames = &robot.frames;
     let mut data = Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
