@@ -584,7 +584,7 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
         // one. (Planting that ankle link planted the shin, its tracked ancestor.)
         (Some(l), Some(r), Ok([rl, rr])) if l != r => {
             let foot = |named: usize, found: usize| {
-                if named != found && crate::feet::is_descendant(model, found, named) {
+                if crate::feet::is_descendant(model, found, named) {
                     found
                 } else {
                     named
