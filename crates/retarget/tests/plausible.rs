@@ -31,6 +31,14 @@ fn slice(full: &fk::HumanMotion, range: std::ops::Range<usize>) -> fk::HumanMoti
     }
 }
 
+/// The first `n` frames of `bvh`.
+fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
+    let n = n.min(bvh.motion.num_frames);
+    bvh.motion.num_frames = n;
+    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh
+}
+
 /// The G1, its tuned config, the shared LAFAN1 jumps take's human motion and its subject
 /// height; `None` without the shared data.
 fn g1_jumps() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
@@ -201,10 +209,7 @@ fn a_clip_that_begins_mid_motion_tracks_from_its_first_frame() {
 #[test]
 fn a_120_fps_take_is_no_more_jittery_than_gmr() {
     let Some(path) = shared::shared_file("data/bvh/cmu_bvh11_131_01.bvh") else { return };
-    let mut bvh = bvh::from_path(&path).unwrap();
-    let n = bvh.motion.num_frames.min(1200);
-    bvh.motion.num_frames = n;
-    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    let bvh = first_frames(bvh::from_path(&path).unwrap(), 1200);
     let jitter = |mode: retarget::SolveMode| {
         let r = retarget::Retargeter::new("unitree_g1").unwrap().with_mode(mode);
         let (motion, _) = r.retarget_bvh(&bvh).unwrap();
@@ -225,10 +230,7 @@ fn the_first_frame_starts_where_the_arms_can_follow() {
     let Some(path) = shared::shared_file("data/bvh/bandai_dataset-1_kick_normal_001.bvh") else {
         return;
     };
-    let mut bvh = bvh::from_path(&path).unwrap();
-    let n = bvh.motion.num_frames.min(100);
-    bvh.motion.num_frames = n;
-    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    let bvh = first_frames(bvh::from_path(&path).unwrap(), 100);
     let retargeter = retarget::Retargeter::new("booster_t1_29dof").unwrap();
     let (motion, _) = retargeter.retarget_bvh(&bvh).unwrap();
     let r = report(&motion, retargeter.model(), &ReportOptions::default()).unwrap();
