@@ -296,8 +296,6 @@ fn bottom_points(
     let up = rest.inverse() * Vector3::z();
     let at = |p: Vector3<f64>| (rel * nalgebra::Point3::from(p)).coords;
     let axis = rel.rotation * Vector3::z();
-    // The unit vector across the geom's axis that points down the most.
-    let down_across = (-up + axis * axis.dot(&up)).try_normalize(1e-9);
     match kind {
         GeomType::Box => {
             let mut all: Vec<Vector3<f64>> = (0..8)
@@ -314,7 +312,10 @@ fn bottom_points(
             [-1.0, 1.0].map(|end| at(Vector3::new(0.0, 0.0, end * size[1])) - up * size[0]).to_vec()
         }
         GeomType::Cylinder if axis.dot(&up).abs() < std::f64::consts::FRAC_1_SQRT_2 => {
-            let Some(across) = down_across else { return Vec::new() };
+            // The unit vector across the axis that points down the most.
+            let Some(across) = (-up + axis * axis.dot(&up)).try_normalize(1e-9) else {
+                return Vec::new();
+            };
             [-1.0, 1.0]
                 .map(|end| at(Vector3::new(0.0, 0.0, end * size[1])) + across * size[0])
                 .to_vec()
