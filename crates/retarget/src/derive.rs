@@ -56,7 +56,8 @@
 //!   point over those postures, with the foot turned as the human's, put
 //!   [`SOLE_CLEARANCE`] above the floor. A robot sole longer than the scaled human foot is
 //!   thereby moved back, so that its toe does not dig in when the human rolls onto the
-//!   ball. The canonical human has one posture (standing).
+//!   ball. The sideways offset stays the copy fit's, so the scaled human's feet stand about
+//!   as far apart as the robot's own. The canonical human has one posture (standing).
 //! - **Scales**, robot over human: the root (pelvis) by the standing hip height (thigh +
 //!   shin + ankle height); the hip by its sideways offset from the pelvis point (midway
 //!   between the hips); the knee by the thigh, the foot by thigh + shin (with the root's
@@ -907,9 +908,13 @@ fn fitted_offset(
 /// scaling of the ankle: the root by `root_scale` about the origin, the ankle by `scale` about the
 /// root). Flat postures fix the height; the postures on the heel or the ball fix how far forward
 /// the body sits (a robot sole longer than the scaled human foot is moved back, so that its toe
-/// does not dig in when the human rolls onto the ball). The horizontal offset stays near `prior`
+/// does not dig in when the human rolls onto the ball). The forward offset stays near `prior`
 /// (the copy fit) where the postures do not decide it: a shift costs as much as the same height
-/// error in [`SOLE_PRIOR`] of the postures.
+/// error in [`SOLE_PRIOR`] of the postures. The sideways offset is the copy fit's: a human
+/// foot rolls sideways by a few degrees, mostly noise, and fitting the sole's height to those
+/// rolls moved the feet up to 5 cm sideways (the scaled LAFAN1 walk's feet 134 mm apart on
+/// the N1, whose feet stand 240 mm apart; the copy fit gives 222), which the default solve's
+/// planted feet then pushed back apart (`keep_feet_apart`).
 fn sole_fit(
     geoms: &[SoleGeom],
     human: &HumanBody,
@@ -919,8 +924,9 @@ fn sole_fit(
     prior: Vector3<f64>,
 ) -> Option<Vector3<f64>> {
     let k = usize::from(role.side() == Some(Side::Right));
-    let mut normal = nalgebra::Matrix3::zeros();
-    let mut rhs = Vector3::zeros();
+    // Unknowns: the forward (x) and height (z) offsets; y is the prior's.
+    let mut normal = nalgebra::Matrix2::zeros();
+    let mut rhs = nalgebra::Vector2::zeros();
     let mut n = 0usize;
     for posture in human.postures.iter().filter(|p| p.feet_down.get(k) == Some(&true)) {
         let (Some(pelvis), Some(ankle), Some(frame)) = (
@@ -936,18 +942,19 @@ fn sole_fit(
         if !(a + low).is_finite() {
             continue;
         }
-        normal += r * r.transpose();
-        rhs -= r * (a + low - SOLE_CLEARANCE);
+        let rxz = nalgebra::Vector2::new(r.x, r.z);
+        normal += rxz * rxz.transpose();
+        rhs -= rxz * (a + low - SOLE_CLEARANCE + r.y * prior.y);
         n += 1;
     }
     if n == 0 {
         return None;
     }
     let w = SOLE_PRIOR * n as f64;
-    normal += nalgebra::Matrix3::from_diagonal(&Vector3::new(w, w, 0.0));
+    normal += nalgebra::Matrix2::new(w, 0.0, 0.0, 0.0);
     rhs.x += w * prior.x;
-    rhs.y += w * prior.y;
-    let fit = normal.try_inverse()? * rhs;
+    let xz = normal.try_inverse()? * rhs;
+    let fit = Vector3::new(xz.x, prior.y, xz.y);
     fit.iter().all(|v| v.is_finite()).then_some(fit)
 }
 
@@ -955,16 +962,17 @@ fn sole_fit(
 /// to, the same for every robot. GMR's solve has no floor: a sole fitted to z = 0 is below it
 /// in about half of the frames, more than 1 cm (the report's penetration) where a rigid sole
 /// cannot follow the human's heel strike and toe-off. Measured on the five robots with GMR
-/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 1.7 to 3.6 points
-/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 3.2 →
-/// 1.3 %, ToddlerBot walk 6.2 → 3.2 %), while stance samples more than 2 cm above the floor
-/// stay fewer than with GMR's configs (at most 1.1 %); the report's sliding share moves by
-/// −1.3 to +0.6 points. The default solve moves every target onto its floor
+/// configs and both LAFAN1 takes (`scripts/compare-configs`): 3 mm takes 2.2 to 3.7 points
+/// off the frames with a geom more than 1 cm in the floor in GMR's solve (G1 walk 8.4 →
+/// 6.1 %, ToddlerBot walk 7.2 → 4.4 %), while stance samples more than 2 cm above the floor
+/// stay fewer than with GMR's configs (at most 1.0 %); the report's sliding share moves by
+/// −1.4 to +0.6 points; 6 mm and 1 cm take penetration down further (G1 walk 4.4, 3.0 %)
+/// and raise the sliding share of every walk (16.9 → 17.6 → 18.4 %). The default solve moves every target onto its floor
 /// ([`crate::feet`]): there the errors move by at most 1 mm and the sliding share by at
 /// most 0.3 points.
 pub const SOLE_CLEARANCE: f64 = 0.003;
 
-/// Weight of the copy fit's horizontal foot offset in [`sole_fit`], as a share of the postures.
+/// Weight of the copy fit's forward foot offset in [`sole_fit`], as a share of the postures.
 const SOLE_PRIOR: f64 = 0.001;
 
 /// One posture's `C_h⁻¹ (x_robot − p_target)` for [`fitted_offset`].

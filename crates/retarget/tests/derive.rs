@@ -5,8 +5,9 @@ mod shared;
 
 use std::path::PathBuf;
 
+use fk::{Part, Role, Side};
 use retarget::derive::{self, Choice, HumanBody};
-use retarget::{IkConfig, RobotRoles};
+use retarget::{IkConfig, RetargetOptions, RobotRoles};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -267,5 +268,49 @@ fn the_derived_config_is_reachable_on_the_jumps() {
         };
         let (hand, foot) = (mean_of(fk::Part::Hand), mean_of(fk::Part::Foot));
         assert!(hand < hand_mm && foot < foot_mm, "{key}: hands {hand:.1} mm, feet {foot:.1} mm");
+    }
+}
+
+/// The scaled human's feet stand about as far apart as the robot's own (the copy fit's
+/// sideways offset): the sideways offset of a foot is not fitted to the sole's height in
+/// the postures where the human's foot rolls a little, which put the scaled LAFAN1 walk's
+/// feet 134 mm apart on the N1 (its feet stand 240 mm apart) and had the default solve push
+/// them back apart (the G1: 188 mm against 237 mm on these frames; 250 mm now). Median over the walk's frames of the foot targets' sideways distance
+/// (across the root's heading) in GMR's solve, against the feet's at `qpos0`.
+#[test]
+fn the_scaled_feet_stand_as_wide_as_the_robots() {
+    let Some(bvh) = lafan_walk() else { return };
+    let bvh = first_frames(bvh, 900);
+    let human = derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
+    // (ToddlerBot's legs are long for its hips: copying the human's thighs brings its feet
+    // in, to 45 mm apart on the whole walk against 74 mm at `qpos0`.)
+    for key in ["unitree_g1", "booster_t1_29dof", "fourier_n1", "engineai_pm01"] {
+        let (model, _) = shipped(key);
+        let roles = RobotRoles::recognise(&model).unwrap();
+        let config = derive::derive(&model, &roles, &human, key).unwrap();
+        let feet = [Side::Left, Side::Right]
+            .map(|s| roles.body(Role::of(Part::Foot, s)).unwrap())
+            .map(|b| model.bodies[b].name.clone());
+        let mut data = mjcf::Data::new(&model);
+        model.kinematics(&model.qpos0, &mut data);
+        let [l, r] = feet.clone().map(|f| data.xpos[model.body_id(&f).unwrap()]);
+        let stand = (l - r).y;
+        let (motion, _) =
+            retarget::retarget_bvh(&bvh, &model, &config, &RetargetOptions::gmr()).unwrap();
+        let targets = motion.targets.as_ref().unwrap();
+        let k = feet.clone().map(|f| targets.body_names.iter().position(|n| *n == f).unwrap());
+        let slots = targets.body_names.len();
+        let mut widths: Vec<f64> = (0..motion.num_frames())
+            .map(|t| {
+                let q = motion.frame(t);
+                let yaw = (2.0 * (q[3] * q[6] + q[4] * q[5]))
+                    .atan2(1.0 - 2.0 * (q[5] * q[5] + q[6] * q[6]));
+                let d = targets.pos[t * slots + k[0]] - targets.pos[t * slots + k[1]];
+                -yaw.sin() * d.x + yaw.cos() * d.y
+            })
+            .collect();
+        widths.sort_by(f64::total_cmp);
+        let median = widths[widths.len() / 2];
+        assert!(median > 0.85 * stand, "{key}: {median:.3} m apart, {stand:.3} m at qpos0");
     }
 }
