@@ -26,8 +26,8 @@
 //!   86 mm from their targets against 69 mm with 10, the PM01's feet 14 mm against 3 mm,
 //!   and the default solve of the PM01 turned its left hip over into a branch at its limits
 //!   for the last half of the take. Table 1 (orientations only) keeps the G1's 100: with 10
-//!   there too, the T1 no longer faces the way the human's pelvis does on a skeleton whose
-//!   pelvis frame is not upright (`scripts/check-any`, MocapBank).
+//!   there too, the T1 no longer faces the way the human's pelvis does on a take that
+//!   kneels and bends over (`scripts/check-any`, MocapBank).
 //!
 //! - **Rotation offset** `q_off = F_h ⊗ C_r⁻¹ ⊗ q_body`: `F_h = q_joint⁻¹ ⊗ C_h` is the
 //!   human's frame offset ([`fk::Humanoid::frame_offsets`], identity for the canonical human),
