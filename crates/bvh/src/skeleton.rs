@@ -135,6 +135,13 @@ impl Motion {
         &self.values[index * self.num_channels..(index + 1) * self.num_channels]
     }
 
+    /// Keeps the first `frames` frames (all of them when there are fewer), values and count
+    /// together.
+    pub fn truncate(&mut self, frames: usize) {
+        self.num_frames = self.num_frames.min(frames);
+        self.values.truncate(self.num_frames * self.num_channels);
+    }
+
     /// Frames per second (`1 / frame_time`).
     #[must_use]
     pub fn fps(&self) -> f64 {
@@ -147,4 +154,25 @@ impl Motion {
 pub struct Bvh {
     pub skeleton: Skeleton,
     pub motion: Motion,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Motion;
+
+    #[test]
+    fn truncating_keeps_the_count_and_the_values_together() {
+        let mut m = Motion {
+            frame_time: 0.1,
+            num_frames: 3,
+            num_channels: 2,
+            values: vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+        };
+        m.truncate(5);
+        assert_eq!((m.num_frames, m.values.len()), (3, 6), "fewer frames than asked: all kept");
+        m.truncate(2);
+        assert_eq!((m.num_frames, m.values.as_slice()), (2, &[1.0, 2.0, 3.0, 4.0][..]));
+        m.truncate(0);
+        assert_eq!((m.num_frames, m.values.len()), (0, 0));
+    }
 }

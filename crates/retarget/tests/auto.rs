@@ -22,9 +22,7 @@ fn root() -> PathBuf {
 }
 
 fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
-    let n = n.min(bvh.motion.num_frames);
-    bvh.motion.num_frames = n;
-    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh.motion.truncate(n);
     bvh
 }
 

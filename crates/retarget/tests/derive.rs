@@ -180,9 +180,7 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
 }
 
 fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
-    let n = n.min(bvh.motion.num_frames);
-    bvh.motion.num_frames = n;
-    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh.motion.truncate(n);
     bvh
 }
 
@@ -275,8 +273,9 @@ fn the_derived_config_is_reachable_on_the_jumps() {
 /// sideways offset): the sideways offset of a foot is not fitted to the sole's height in
 /// the postures where the human's foot rolls a little, which put the scaled LAFAN1 walk's
 /// feet 134 mm apart on the N1 (its feet stand 240 mm apart) and had the default solve push
-/// them back apart (the G1: 188 mm against 237 mm on these frames; 250 mm now). Median over the walk's frames of the foot targets' sideways distance
-/// (across the root's heading) in GMR's solve, against the feet's at `qpos0`.
+/// them back apart (the G1: 188 mm against 237 mm on these frames; 250 mm now). Median over
+/// the walk's frames of the foot targets' sideways distance (across the root's heading) in
+/// GMR's solve, against the feet's at `qpos0`.
 #[test]
 fn the_scaled_feet_stand_as_wide_as_the_robots() {
     let Some(bvh) = lafan_walk() else { return };
@@ -288,17 +287,15 @@ fn the_scaled_feet_stand_as_wide_as_the_robots() {
         let (model, _) = shipped(key);
         let roles = RobotRoles::recognise(&model).unwrap();
         let config = derive::derive(&model, &roles, &human, key).unwrap();
-        let feet = [Side::Left, Side::Right]
-            .map(|s| roles.body(Role::of(Part::Foot, s)).unwrap())
-            .map(|b| model.bodies[b].name.clone());
+        let feet = [Side::Left, Side::Right].map(|s| roles.body(Role::of(Part::Foot, s)).unwrap());
         let mut data = mjcf::Data::new(&model);
         model.kinematics(&model.qpos0, &mut data);
-        let [l, r] = feet.clone().map(|f| data.xpos[model.body_id(&f).unwrap()]);
-        let stand = (l - r).y;
+        let stand = (data.xpos[feet[0]] - data.xpos[feet[1]]).y;
         let (motion, _) =
             retarget::retarget_bvh(&bvh, &model, &config, &RetargetOptions::gmr()).unwrap();
         let targets = motion.targets.as_ref().unwrap();
-        let k = feet.clone().map(|f| targets.body_names.iter().position(|n| *n == f).unwrap());
+        let k = feet
+            .map(|b| targets.body_names.iter().position(|n| *n == model.bodies[b].name).unwrap());
         let slots = targets.body_names.len();
         let mut widths: Vec<f64> = (0..motion.num_frames())
             .map(|t| {

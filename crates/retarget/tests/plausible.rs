@@ -33,9 +33,7 @@ fn slice(full: &fk::HumanMotion, range: std::ops::Range<usize>) -> fk::HumanMoti
 
 /// The first `n` frames of `bvh`.
 fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
-    let n = n.min(bvh.motion.num_frames);
-    bvh.motion.num_frames = n;
-    bvh.motion.values.truncate(n * bvh.motion.num_channels);
+    bvh.motion.truncate(n);
     bvh
 }
 
