@@ -1,7 +1,8 @@
 //! Typed MJCF tree → [`Model`], following MuJoCo's compiler (`user_model.cc`, `user_objects.cc`):
 //! default classes with inheritance and `childclass`, angle units, orientation specifiers,
 //! `<frame>` composition, `autolimits`, joint addresses and `qpos0`; the collision filter's
-//! inputs (geom `contype`/`conaffinity`, `<contact>` excludes and pairs, `filterparent`).
+//! inputs (geom `contype`/`conaffinity`, `<contact>` excludes and pairs, `filterparent`); body
+//! mass and inertia from `<inertial>` (see `inertia`).
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -9,12 +10,13 @@ use std::f64::consts::PI;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::error::Error;
+use crate::inertia::{self, InertiaOptions};
 use crate::math::{orientation_to_quat, z_to_quat};
-use crate::model::{Body, Geom, GeomType, Joint, JointType, Model, Site};
+use crate::model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
 use crate::source::{Pos, Sources};
 use crate::syntax::{
-    AngleUnit, BodySpec, DefaultSpec, GeomAttrs, GeomSpec, Item, JointAttrs, JointSpec, Limited,
-    Mjcf, NameRef, Orientation,
+    AngleUnit, BodySpec, CompilerSpec, DefaultSpec, GeomAttrs, GeomSpec, InertiaSpec, InertialSpec,
+    Item, JointAttrs, JointSpec, Limited, Mjcf, NameRef, Orientation,
 };
 
 /// A default class with its ancestors' attributes merged in.
@@ -57,6 +59,7 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
         },
         eulerseq: c.eulerseq.unwrap_or(*b"xyz"),
         autolimits: c.autolimits.unwrap_or(true),
+        inertia: inertia_options(c),
         model: Model {
             name: mjcf.model_name.clone().unwrap_or_default(),
             nq: 0,
@@ -79,7 +82,11 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
     };
     let main_class = mjcf.default.class.clone();
     compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
+    let total_mass = compiler.inertia.total_mass;
     let mut model = compiler.model;
+    if let Some(total) = total_mass {
+        inertia::set_total_mass(&mut model.bodies, total);
+    }
     model.contact_excludes = resolve_names(&mjcf.contact.excludes, src, "body", |n| {
         model.bodies.iter().position(|b| b.name == n)
     })?;
@@ -88,6 +95,17 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
     model.geom_mat = model.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
     model.site_mat = model.sites.iter().map(|s| *s.quat.to_rotation_matrix().matrix()).collect();
     Ok(model)
+}
+
+/// MuJoCo's defaults: `inertiafromgeom="auto"`, no bounds, no balancing, no total mass.
+fn inertia_options(c: &CompilerSpec) -> InertiaOptions {
+    InertiaOptions {
+        from_geom: c.inertiafromgeom.unwrap_or(false),
+        boundmass: c.boundmass.unwrap_or(0.0),
+        boundinertia: c.boundinertia.unwrap_or(0.0),
+        balance: c.balanceinertia.unwrap_or(false),
+        total_mass: c.settotalmass.filter(|&m| m > 0.0),
+    }
 }
 
 /// Ids of the named bodies or geoms of `<exclude>`/`<pair>` elements (MuJoCo rejects unknown
@@ -158,11 +176,13 @@ fn merge_geom(own: &GeomAttrs, base: &GeomAttrs) -> GeomAttrs {
     }
 }
 
-/// What a body owns directly (also through `<frame>`s): joints, geoms, sites, child bodies.
+/// What a body owns directly (also through `<frame>`s): joints, geoms, sites, inertials (one
+/// at most), child bodies.
 struct Contents<'a> {
     joints: Vec<(&'a JointSpec, Option<Pos>, &'a str)>,
     geoms: Vec<(&'a GeomSpec, Frame, &'a str)>,
     sites: Vec<(&'a GeomSpec, Frame, &'a str)>,
+    inertials: Vec<(&'a InertialSpec, Frame)>,
     bodies: Vec<(&'a BodySpec, Frame, &'a str)>,
 }
 
@@ -172,6 +192,7 @@ struct Compiler<'a> {
     angle_scale: f64,
     eulerseq: [u8; 3],
     autolimits: bool,
+    inertia: InertiaOptions,
     model: Model,
 }
 
@@ -191,9 +212,11 @@ impl<'a> Compiler<'a> {
             joints: Vec::new(),
             geoms: Vec::new(),
             sites: Vec::new(),
+            inertials: Vec::new(),
             bodies: Vec::new(),
         };
         self.collect(&spec.items, Frame::IDENTITY, class, None, &mut contents)?;
+        let inertial = self.inertial(&contents.inertials, id)?;
         self.model.bodies.push(Body {
             name: spec.name.clone().unwrap_or_default(),
             parent,
@@ -203,6 +226,7 @@ impl<'a> Compiler<'a> {
             jnt_num: contents.joints.len(),
             dof_adr: self.model.nv,
             dof_num: 0,
+            inertial,
         });
         let parent_last_dof =
             if id == 0 { None } else { self.model.body_last_dof.get(parent).copied().flatten() };
@@ -253,6 +277,7 @@ impl<'a> Compiler<'a> {
                 Item::Joint(j) => out.joints.push((j, in_frame, class)),
                 Item::Geom(g) => out.geoms.push((g, frame, class)),
                 Item::Site(s) => out.sites.push((s, frame, class)),
+                Item::Inertial(i) => out.inertials.push((i, frame)),
                 Item::Body(b) => out.bodies.push((b, frame, class)),
                 Item::Frame(f) => {
                     let pos = Vector3::from(f.translation.unwrap_or_default());
@@ -288,6 +313,40 @@ impl<'a> Compiler<'a> {
                 })
             }
         }
+    }
+
+    /// The body's mass and inertia as `mjCBody::Compile` makes them from its `<inertial>`:
+    /// `fullinertia` diagonalised, orientation in the compiler's angle unit and `eulerseq`,
+    /// bounds and balancing, placed through the `<frame>`s around it. `None` without one, and
+    /// with `inertiafromgeom="true"` (MuJoCo then ignores it for the geoms' masses).
+    fn inertial(
+        &self,
+        found: &[(&InertialSpec, Frame)],
+        body: usize,
+    ) -> Result<Option<Inertial>, Error> {
+        let (spec, frame) = match found {
+            [] => return Ok(None),
+            [one] => one,
+            // MuJoCo's schema rejects two in one body; through <frame>s the last would win.
+            [_, (second, _), ..] => {
+                return Err(self.src.invalid(second.pos, "more than one <inertial> in a body"))
+            }
+        };
+        if body == 0 {
+            return Err(self.src.invalid(spec.pos, "the world body cannot have an <inertial>"));
+        }
+        let (quat, diag) = match spec.inertia {
+            InertiaSpec::Full(full) => inertia::principal_axes(&inertia::full_matrix(full))
+                .map_err(|e| self.src.invalid(spec.pos, format!("fullinertia: {e}")))?,
+            InertiaSpec::Diag(d) => (self.orientation(spec.orientation.as_ref())?, d.into()),
+        };
+        if self.inertia.from_geom {
+            return Ok(None);
+        }
+        let (mass, diag) = inertia::bound_and_check(spec.mass, diag, &self.inertia)
+            .map_err(|e| self.src.invalid(spec.pos, e))?;
+        let local = Inertial { mass, pos: spec.translation.into(), quat, diag };
+        Ok(Some(inertia::placed(&local, &frame.pos, &frame.quat)))
     }
 
     // `body` and its parent are ids this builder assigned (the body being compiled).
@@ -466,10 +525,128 @@ impl<'a> Compiler<'a> {
 mod tests {
     use std::f64::consts::FRAC_PI_2;
 
-    use crate::{JointType, Model};
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+    use crate::inertia::{full_matrix, tensor};
+    use crate::{Inertial, JointType, Model};
 
     fn model(xml: &str) -> Model {
         Model::from_xml_str(xml, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn inertial(m: &Model, body: &str) -> Inertial {
+        m.bodies[m.body_id(body).unwrap()].inertial.unwrap()
+    }
+
+    /// With the `mujoco` feature: MuJoCo 3.17.0 compiles `xml` to the same model, `inertials`
+    /// bodies compared. Without it the hand numbers of each test stand alone.
+    fn matches_mujoco(m: &Model, xml: &str, inertials: usize) {
+        #[cfg(feature = "mujoco")]
+        {
+            use crate::mujoco_check::{check_xml_str, CheckOptions, INERTIAL_TOLERANCE};
+            let options = CheckOptions { configs: 2, seed: 1 };
+            let report = check_xml_str(m, xml, "<test>", options).unwrap_or_else(|e| panic!("{e}"));
+            assert!(report.passes(INERTIAL_TOLERANCE), "{report}");
+            assert_eq!(report.inertials, inertials, "{report}");
+        }
+        #[cfg(not(feature = "mujoco"))]
+        let _ = (m, xml, inertials);
+    }
+
+    #[test]
+    fn diaginertia_takes_its_orientation_and_frames() {
+        let xml = r#"<mujoco><compiler eulerseq="zyx"/><worldbody>
+            <body name="a" pos="0 0 1"><joint/><geom size="0.1"/>
+              <inertial pos="0.1 0.2 0.3" mass="2" quat="0 1 0 1" diaginertia="0.1 0.2 0.25"/>
+            </body>
+            <body name="b"><joint/><geom size="0.1"/>
+              <frame pos="1 0 0" euler="90 0 0">
+                <inertial pos="1 0 0" mass="1" euler="0 0 90" diaginertia="1 2 3"/>
+              </frame>
+            </body>
+            <body name="c"><joint/><geom size="0.1"/></body>
+          </worldbody></mujoco>"#;
+        let m = model(xml);
+        let a = inertial(&m, "a");
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert_eq!(
+            (a.mass, a.pos, a.diag),
+            (2.0, Vector3::new(0.1, 0.2, 0.3), Vector3::new(0.1, 0.2, 0.25))
+        );
+        assert!((a.quat.coords - Quaternion::new(0.0, h, 0.0, h).coords).norm() < 1e-15);
+        // eulerseq zyx in degrees: the frame turns 90° about z, the inertial 90° about x.
+        let b = inertial(&m, "b");
+        let (rz, rx) = (Vector3::z_axis(), Vector3::x_axis());
+        let expected = UnitQuaternion::from_axis_angle(&rz, FRAC_PI_2)
+            * UnitQuaternion::from_axis_angle(&rx, FRAC_PI_2);
+        assert!((b.pos - Vector3::new(1.0, 1.0, 0.0)).norm() < 1e-15);
+        assert!(b.quat.angle_to(&expected) < 1e-15);
+        assert_eq!(m.bodies[m.body_id("c").unwrap()].inertial, None);
+        matches_mujoco(&m, xml, 2);
+    }
+
+    #[test]
+    fn fullinertia_is_diagonalised() {
+        let xml = r#"<mujoco><worldbody><body name="a"><joint/><geom size="0.1"/>
+            <inertial pos="0 0 0.1" mass="1.5" fullinertia="3 3.5 4 0.1 0.2 0.3"/>
+          </body></worldbody></mujoco>"#;
+        let m = model(xml);
+        let a = inertial(&m, "a");
+        // MuJoCo 3.17.0's body_inertia for this body, largest first.
+        let moments = Vector3::new(4.18276016566592, 3.3595649771583007, 2.957674857175793);
+        assert!((a.diag - moments).norm() < 1e-13, "{}", a.diag);
+        assert!((tensor(&a) - full_matrix([3.0, 3.5, 4.0, 0.1, 0.2, 0.3])).norm() < 1e-14);
+        assert_eq!((a.mass, a.pos), (1.5, Vector3::new(0.0, 0.0, 0.1)));
+        matches_mujoco(&m, xml, 1);
+    }
+
+    #[test]
+    fn inertiafromgeom_true_ignores_inertials() {
+        let xml = |compiler: &str| {
+            format!(
+                r#"<mujoco><compiler {compiler}/><worldbody><body name="a"><joint/><geom size="0.1"/>
+                   <inertial pos="0 0 0" mass="1" diaginertia="1 1 3"/></body></worldbody></mujoco>"#
+            )
+        };
+        // MuJoCo checks A + B >= C on the geoms' inertia then: no error for the unused one.
+        let m = model(&xml(r#"inertiafromgeom="true""#));
+        assert_eq!(m.bodies[1].inertial, None);
+        matches_mujoco(&m, &xml(r#"inertiafromgeom="true""#), 0);
+        let err = Model::from_xml_str(&xml(r#"inertiafromgeom="false""#), None).unwrap_err();
+        assert!(err.to_string().contains("inertia must satisfy A + B >= C"), "{err}");
+        let balanced = xml(r#"inertiafromgeom="false" balanceinertia="true""#);
+        assert_eq!(inertial(&model(&balanced), "a").diag, Vector3::repeat(5.0 / 3.0));
+        matches_mujoco(&model(&balanced), &balanced, 1);
+    }
+
+    #[test]
+    fn bounds_and_total_mass_follow_mujoco() {
+        let xml = |compiler: &str, extra: &str| {
+            format!(
+                r#"<mujoco><compiler {compiler}/><worldbody>
+                   <body name="a"><joint/><inertial pos="0 0 0" mass="0.001" diaginertia="1 2 3"/></body>
+                   <body name="b"><joint/><inertial pos="0 0 0" mass="3" diaginertia="0.1 0.1 0.1"/></body>
+                   {extra}</worldbody></mujoco>"#
+            )
+        };
+        let bounded = xml(r#"boundmass="0.01" boundinertia="1.5""#, "");
+        let m = model(&bounded);
+        assert_eq!(
+            (inertial(&m, "a").mass, inertial(&m, "a").diag),
+            (0.01, Vector3::new(1.5, 2.0, 3.0))
+        );
+        assert_eq!(inertial(&m, "b").diag, Vector3::repeat(1.5));
+        matches_mujoco(&m, &bounded, 2);
+        // settotalmass scales every mass and moment by one factor: 6 / 3.001. (MuJoCo 3.17.0
+        // does the same, and warns that the attribute is deprecated into MUJOCO_LOG.TXT, so
+        // it is not asked here.)
+        let m = model(&xml(r#"settotalmass="6""#, ""));
+        let scale = 6.0 / 3.001;
+        assert!((inertial(&m, "b").mass - 3.0 * scale).abs() < 1e-15);
+        assert!((inertial(&m, "a").diag - Vector3::new(1.0, 2.0, 3.0) * scale).norm() < 1e-14);
+        // A body whose mass MuJoCo takes from its geom: the sum is unknown here.
+        let partly = xml(r#"settotalmass="6""#, r#"<body name="c"><geom size="0.1"/></body>"#);
+        assert!(model(&partly).bodies.iter().all(|b| b.inertial.is_none()));
     }
 
     #[test]

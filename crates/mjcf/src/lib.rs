@@ -5,14 +5,15 @@
 //! typed tree of what the file says (`syntax`), which is then compiled (`compile`) the way
 //! MuJoCo's compiler does it: default classes and `childclass`, the compiler's `angle` unit and
 //! `eulerseq`, every orientation form (`quat`, `axisangle`, `euler`, `xyaxes`, `zaxis`),
-//! `<frame>`, `fromto`, `autolimits`. The kinematic functions reproduce `mj_kinematics`,
+//! `<frame>`, `fromto`, `autolimits`, and body mass and inertia from `<inertial>`
+//! ([`Body::inertial`]). The kinematic functions reproduce `mj_kinematics`,
 //! `mj_jac`/`mj_jacBody` and `mj_integratePos`; the `mujoco` feature adds the module
 //! `mujoco_check`, which compares everything with MuJoCo 3.17.0 itself (a plain name: without
 //! the feature there is nothing to link to, and rustdoc denies the broken link).
 //!
 //! URDF is read into the same [`Model`] ([`Model::from_urdf_file`], [`Model::from_path`]) with
-//! the semantics of MuJoCo's URDF import (static links fused into their parent, visuals
-//! dropped, `rpy` as fixed-axis roll-pitch-yaw), plus a free root joint unless
+//! the semantics of MuJoCo's URDF import (static links fused into their parent with their
+//! inertia, visuals dropped, `rpy` as fixed-axis roll-pitch-yaw), plus a free root joint unless
 //! [`UrdfBase::Fixed`] is asked for; `<limit velocity>` becomes [`Joint::velocity_limit`].
 //!
 //! ```
@@ -32,6 +33,7 @@
 pub mod collision;
 mod compile;
 mod error;
+mod inertia;
 mod kinematics;
 mod math;
 mod model;
@@ -51,7 +53,7 @@ pub use collision::{
 pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;
-pub use model::{Body, Geom, GeomType, Joint, JointType, Model, Site};
+pub use model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
 pub use urdf::{UrdfBase, UrdfOptions};
 
 impl Model {

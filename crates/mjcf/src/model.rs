@@ -81,6 +81,49 @@ pub struct Body {
     pub dof_adr: usize,
     /// Number of dofs of this body.
     pub dof_num: usize,
+    /// Mass and inertia as MuJoCo compiles them from the file's `<inertial>` (MuJoCo's
+    /// `body_mass`, `body_ipos`, `body_iquat`, `body_inertia`; URDF static links fused in).
+    /// `None` for the world and where MuJoCo takes them from the geoms, which is not done
+    /// here: no `<inertial>`, `inertiafromgeom="true"`, and the other cases the URDF reader
+    /// lists; with `settotalmass`, `None` everywhere unless every body has one.
+    pub inertial: Option<Inertial>,
+}
+
+/// A body's mass and its inertia in the principal frame (MuJoCo's `body_ipos`, `body_iquat`,
+/// `body_inertia`, `body_mass`). A full tensor (`fullinertia`, URDF `<inertia>`, fused links)
+/// is diagonalised with the moments largest first, as MuJoCo does; the axes may then differ
+/// from its `body_iquat` in sign (and among equal moments), the tensor `R diag Rᵀ` being the
+/// same.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inertial {
+    /// kg.
+    pub mass: f64,
+    /// Centre of mass in the body frame (m).
+    pub pos: Vector3<f64>,
+    /// Principal axes in the body frame.
+    pub quat: UnitQuaternion<f64>,
+    /// Principal moments of inertia about the centre of mass (kg m²).
+    pub diag: Vector3<f64>,
+}
+
+impl Inertial {
+    /// Half sizes of the uniform box with this mass and these principal moments, along the
+    /// principal axes: `a² = 6 (I_y + I_z − I_x) / m` for the full side `a` along x, and so on.
+    /// `None` for a massless body or moments that no box has (the triangle inequality fails
+    /// by more than rounding).
+    #[must_use]
+    pub fn equivalent_box(&self) -> Option<Vector3<f64>> {
+        let [x, y, z] = [self.diag.x, self.diag.y, self.diag.z];
+        let m = self.mass;
+        if m.is_nan() || m <= 0.0 {
+            return None;
+        }
+        let side = |a: f64, b: f64, c: f64| {
+            let sq = 6.0 * (b + c - a) / m;
+            (sq > 0.0 && sq.is_finite()).then(|| sq.sqrt() / 2.0)
+        };
+        Some(Vector3::new(side(x, y, z)?, side(y, z, x)?, side(z, x, y)?))
+    }
 }
 
 /// A joint, in the frame of its body.

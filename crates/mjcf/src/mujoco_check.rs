@@ -1,7 +1,8 @@
 //! Our kinematics against MuJoCo 3.17.0's on the same file (cargo feature `mujoco`): the
-//! compiled model (sizes, names, order, ranges, `qpos0`, body and joint frames) and, at random
-//! configurations, every body pose, every body Jacobian and every geom and site position.
-//! Shared by the parity tests and `retarget robot check`.
+//! compiled model (sizes, names, order, ranges, `qpos0`, body and joint frames, the inertial
+//! of every body that has one here) and, at random configurations, every body pose, every
+//! body Jacobian and every geom and site position. Shared by the parity tests and
+//! `retarget robot check`.
 //!
 //! A URDF is compiled by MuJoCo's own URDF import (`mj_loadXML` reads `<robot>` files). MuJoCo
 //! adds no free joint there, so a model read with [`UrdfBase::Fixed`] is compared with that
@@ -19,11 +20,11 @@ use std::fmt;
 use std::path::Path;
 
 use mujoco_rs::prelude::{MjModel, MjSpec, MjtJoint, MjtObjBase, SpecElement, SpecItem};
-use nalgebra::Vector3;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::{Data, Error, GeomType, JointType, Model, UrdfBase, UrdfOptions};
+use crate::{Data, Error, GeomType, Inertial, JointType, Model, UrdfBase, UrdfOptions};
 
 /// How many random configurations (checked in addition to `qpos0`), from which seed.
 #[derive(Debug, Clone, Copy)]
@@ -37,6 +38,10 @@ impl Default for CheckOptions {
         CheckOptions { configs: 100, seed: 20_251_122 }
     }
 }
+
+/// An inertial deviating from MuJoCo's by more than this (kg, m, kg m²: the parity tests'
+/// tolerance) is also a [`Report::mismatches`] line, naming the body.
+pub const INERTIAL_TOLERANCE: f64 = 1e-9;
 
 /// Result of [`check_file`]: structural mismatches (empty when the models agree) and the
 /// largest absolute deviations seen (quaternions compared up to sign).
@@ -52,6 +57,12 @@ pub struct Report {
     pub max_jacr: f64,
     /// Geoms other than meshes, and sites.
     pub max_geom_site: f64,
+    /// Bodies (the world aside) whose inertial was compared, and those without one here
+    /// ([`Body::inertial`](crate::Body::inertial) `None`), not compared.
+    pub inertials: usize,
+    pub inertials_skipped: usize,
+    /// Largest deviation of mass, centre of mass or inertia tensor about it in the body frame.
+    pub max_inertial: f64,
 }
 
 impl Report {
@@ -65,6 +76,7 @@ impl Report {
             self.max_jacp,
             self.max_jacr,
             self.max_geom_site,
+            self.max_inertial,
         ]
         .into_iter()
         .fold(0.0, f64::max)
@@ -88,6 +100,11 @@ impl fmt::Display for Report {
             writeln!(f, "  {m}")?;
         }
         writeln!(f, "max |model data| deviation:  {:.3e}", self.max_static)?;
+        writeln!(
+            f,
+            "max |inertial| deviation:    {:.3e} ({} bodies compared, {} without an inertial here)",
+            self.max_inertial, self.inertials, self.inertials_skipped
+        )?;
         writeln!(f, "over qpos0 and {} random configurations:", self.configs)?;
         writeln!(f, "  max |xpos| deviation:        {:.3e} m", self.max_xpos)?;
         writeln!(f, "  max |xquat| deviation:       {:.3e}", self.max_xquat)?;
@@ -193,6 +210,7 @@ fn compare_structure(model: &Model, mj: &MjModel, report: &mut Report) {
         return;
     }
     compare_bodies(model, mj, report);
+    compare_inertials(model, mj, report);
     compare_joints(model, mj, report);
     let qpos0 = mj.qpos0();
     report.max_static = report.max_static.max(qpos0_dev(model, qpos0));
@@ -212,6 +230,45 @@ fn compare_bodies(model: &Model, mj: &MjModel, report: &mut Report) {
         let d = max_abs(b.pos.as_slice(), &pos[i])
             .max(quat_dev(&[b.quat.w, b.quat.i, b.quat.j, b.quat.k], &quat[i]));
         report.max_static = report.max_static.max(d);
+    }
+}
+
+/// Every body with an inertial here against MuJoCo's `body_mass`, `body_ipos` and the tensor
+/// `R diag Rᵀ` of `body_iquat`, `body_inertia` (principal axes have no unique order or sign).
+fn compare_inertials(model: &Model, mj: &MjModel, report: &mut Report) {
+    let (mass, ipos, iquat, inertia) =
+        (mj.body_mass(), mj.body_ipos(), mj.body_iquat(), mj.body_inertia());
+    for (i, body) in model.bodies.iter().enumerate().skip(1) {
+        let Some(ours) = &body.inertial else {
+            report.inertials_skipped += 1;
+            continue;
+        };
+        let [w, x, y, z] = iquat[i];
+        let theirs = Inertial {
+            mass: mass[i],
+            pos: Vector3::from(ipos[i]),
+            quat: UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z)),
+            diag: Vector3::from(inertia[i]),
+        };
+        let tensor = crate::inertia::tensor;
+        let d = (ours.mass - theirs.mass)
+            .abs()
+            .max((ours.pos - theirs.pos).amax())
+            .max((tensor(ours) - tensor(&theirs)).amax());
+        report.inertials += 1;
+        report.max_inertial = report.max_inertial.max(d);
+        if d > INERTIAL_TOLERANCE {
+            report.mismatches.push(format!(
+                "body {i} {:?}: inertial ours mass {} com {:?} moments {:?}, mujoco mass {} com {:?} moments {:?} (deviation {d:.3e})",
+                body.name,
+                ours.mass,
+                ours.pos.as_slice(),
+                ours.diag.as_slice(),
+                theirs.mass,
+                theirs.pos.as_slice(),
+                theirs.diag.as_slice()
+            ));
+        }
     }
 }
 

@@ -1,9 +1,10 @@
 //! The typed MJCF tree: what the file says, attribute by attribute, before any default,
 //! class, unit or frame is applied (that is `compile`'s job). Only the parts that matter for
 //! kinematics and collision filtering are kept (geom `contype`/`conaffinity`, `<contact>`'s
-//! `<exclude>` and `<pair>`, `<option><flag filterparent>`); elements that cannot change a body
-//! pose or which geoms may collide (actuators, sensors, assets, visual, ...) are skipped, and
-//! elements that would change one but are not implemented are an
+//! `<exclude>` and `<pair>`, `<option><flag filterparent>`), plus `<inertial>` and the
+//! `<compiler>` attributes that change it; elements that cannot change a body pose or which
+//! geoms may collide (actuators, sensors, assets, visual, ...) are skipped, and elements that
+//! would change one but are not implemented are an
 //! [`Error::Unsupported`](crate::Error::Unsupported).
 
 use crate::error::Error;
@@ -22,6 +23,12 @@ pub(crate) struct CompilerSpec {
     pub angle: Option<AngleUnit>,
     pub eulerseq: Option<[u8; 3]>,
     pub autolimits: Option<bool>,
+    /// `inertiafromgeom="true"` (`false` and `auto` both keep explicit inertials).
+    pub inertiafromgeom: Option<bool>,
+    pub boundmass: Option<f64>,
+    pub boundinertia: Option<f64>,
+    pub balanceinertia: Option<bool>,
+    pub settotalmass: Option<f64>,
 }
 
 /// One orientation specifier as written (units and sequence resolved by `compile`).
@@ -94,11 +101,30 @@ pub(crate) struct GeomSpec {
     pub pos: Pos,
 }
 
+/// The inertia of an `<inertial>`: `diaginertia` on the axes of its orientation, or
+/// `fullinertia` (`ixx iyy izz ixy ixz iyz`), which brings its own axes. Neither: zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum InertiaSpec {
+    Diag([f64; 3]),
+    Full([f64; 6]),
+}
+
+/// `<inertial>`: `pos` and `mass` are required, as in MuJoCo.
+#[derive(Debug, Clone)]
+pub(crate) struct InertialSpec {
+    pub translation: [f64; 3],
+    pub mass: f64,
+    pub inertia: InertiaSpec,
+    pub orientation: Option<(Orientation, Pos)>,
+    pub pos: Pos,
+}
+
 #[derive(Debug, Clone)]
 pub(crate) enum Item {
     Joint(JointSpec),
     Geom(GeomSpec),
     Site(GeomSpec),
+    Inertial(InertialSpec),
     Body(BodySpec),
     Frame(BodySpec),
 }
@@ -156,7 +182,7 @@ const IGNORED_SECTIONS: &[&str] = &[
 ];
 
 /// Elements inside bodies that cannot change body poses: skipped.
-const IGNORED_IN_BODY: &[&str] = &["inertial", "camera", "light", "plugin"];
+const IGNORED_IN_BODY: &[&str] = &["camera", "light", "plugin"];
 
 pub(crate) fn parse(root: &Element, src: &Sources) -> Result<Mjcf, Error> {
     let mut mjcf = Mjcf {
@@ -213,6 +239,14 @@ fn parse_compiler(el: &Element, src: &Sources, c: &mut CompilerSpec) -> Result<(
             }
             "eulerseq" => c.eulerseq = Some(eulerseq(a, src)?),
             "autolimits" => c.autolimits = Some(boolean(a, src)?),
+            "inertiafromgeom" => {
+                let options = [("false", false), ("true", true), ("auto", false)];
+                c.inertiafromgeom = Some(keyword(a, src, &options)?);
+            }
+            "boundmass" => c.boundmass = Some(floats::<1>(a, src)?[0]),
+            "boundinertia" => c.boundinertia = Some(floats::<1>(a, src)?[0]),
+            "balanceinertia" => c.balanceinertia = Some(boolean(a, src)?),
+            "settotalmass" => c.settotalmass = Some(floats::<1>(a, src)?[0]),
             "fusestatic" | "alignfree" if boolean(a, src)? => {
                 return Err(src.unsupported(
                     a.pos,
@@ -310,6 +344,10 @@ fn parse_item(el: &Element, src: &Sources, in_world: bool) -> Result<Option<Item
         "freejoint" => Item::Joint(parse_freejoint(el, src)?),
         "geom" => Item::Geom(parse_geom(el, src)?),
         "site" => Item::Site(parse_geom(el, src)?),
+        "inertial" if in_world => {
+            return Err(src.invalid(el.pos, "the world body cannot have an <inertial>"));
+        }
+        "inertial" => Item::Inertial(parse_inertial(el, src)?),
         name if IGNORED_IN_BODY.contains(&name) => return Ok(None),
         other => return Err(src.unsupported(el.pos, format!("element <{other}> in a body"))),
     };
@@ -366,6 +404,53 @@ fn parse_geom(el: &Element, src: &Sources) -> Result<GeomSpec, Error> {
         attrs: geom_attrs(el, src)?,
         pos: el.pos,
     })
+}
+
+/// `<inertial>` with MuJoCo's rules: `pos` and `mass` required, one of `diaginertia` and
+/// `fullinertia`, no orientation with `fullinertia`; a negative mass or moment is an error here
+/// (MuJoCo raises it to `boundmass`, 0 by default, and then rejects it on a moving body).
+fn parse_inertial(el: &Element, src: &Sources) -> Result<InertialSpec, Error> {
+    let required = |name: &str| {
+        el.attr(name)
+            .ok_or_else(|| src.invalid(el.pos, format!("<inertial> needs the attribute {name}")))
+    };
+    let mass_attr = required("mass")?;
+    let [mass] = floats::<1>(mass_attr, src)?;
+    if mass < 0.0 {
+        let message = format!("attribute mass=\"{}\": must not be negative", mass_attr.value);
+        return Err(src.invalid(mass_attr.pos, message));
+    }
+    let spec = InertialSpec {
+        translation: floats::<3>(required("pos")?, src)?,
+        mass,
+        inertia: inertia(el, src)?,
+        orientation: orientation(el, src)?,
+        pos: el.pos,
+    };
+    if let (InertiaSpec::Full(_), Some((_, at))) = (spec.inertia, spec.orientation) {
+        return Err(src.invalid(
+            at,
+            "fullinertia and an orientation on one <inertial> (fullinertia brings its own axes)",
+        ));
+    }
+    Ok(spec)
+}
+
+/// `diaginertia` (non-negative) or `fullinertia`, not both.
+fn inertia(el: &Element, src: &Sources) -> Result<InertiaSpec, Error> {
+    let full = el.attr("fullinertia").map(|a| floats::<6>(a, src)).transpose()?;
+    let Some(a) = el.attr("diaginertia") else {
+        return Ok(full.map_or(InertiaSpec::Diag([0.0; 3]), InertiaSpec::Full));
+    };
+    let diag = floats::<3>(a, src)?;
+    if full.is_some() {
+        return Err(src.invalid(a.pos, "<inertial> with both diaginertia and fullinertia"));
+    }
+    if diag.iter().any(|&d| d < 0.0) {
+        let message = format!("attribute diaginertia=\"{}\": must not be negative", a.value);
+        return Err(src.invalid(a.pos, message));
+    }
+    Ok(InertiaSpec::Diag(diag))
 }
 
 fn joint_attrs(el: &Element, src: &Sources) -> Result<JointAttrs, Error> {

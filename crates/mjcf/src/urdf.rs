@@ -29,9 +29,17 @@
 //!   file, as MuJoCo names it): no mesh file is read, so its pose is as written and it has no
 //!   size (see [`Geom::mesh`](crate::Geom::mesh)). A repeated geom name is dropped (the geom
 //!   stays, unnamed), as MuJoCo does. Collision geoms are MuJoCo's `contype = conaffinity = 1`.
-//! - `<visual>` is discarded (MuJoCo's URDF default `discardvisual="true"`); inertials,
-//!   dynamics, effort, mimic, transmissions, materials and gazebo tags do not change
-//!   kinematics and are skipped.
+//! - `<inertial>` → [`Body::inertial`](crate::Body::inertial): `<inertia>` is a full tensor in
+//!   the frame of the inertial's `<origin>`, diagonalised (all zeros: a point mass, as MuJoCo
+//!   reads it), then checked as MuJoCo's compiler checks a body (`balanceinertia` from
+//!   `<mujoco><compiler>` applies). A fused static link's mass, centre of mass and inertia are
+//!   combined into its body's (parallel-axis theorem, diagonalised again); into the world they
+//!   go nowhere. `None` for a body whose mass MuJoCo takes from collision geoms (its own link
+//!   or a fused one without `<inertial>` but with collisions, unless `inertiafromgeom="false"`),
+//!   and for every body with `inertiafromgeom="true"`, `boundmass` or `boundinertia` (which
+//!   MuJoCo applies to every link before fusing, massless ones included).
+//! - `<visual>` is discarded (MuJoCo's URDF default `discardvisual="true"`); dynamics, effort,
+//!   mimic, transmissions, materials and gazebo tags do not change kinematics and are skipped.
 //!
 //! MuJoCo adds no free joint when it compiles a URDF on its own, so the robot is fixed to the
 //! world there. Retargeting needs a free root, so by default ([`UrdfBase::Floating`]) the root
@@ -48,8 +56,9 @@ use std::collections::{HashMap, HashSet};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::error::{Error, Location};
+use crate::inertia::{self, InertiaOptions, MJ_MINVAL, NO_MASS};
 use crate::math::{orientation_to_quat, z_to_quat};
-use crate::model::{Body, Geom, GeomType, Joint, JointType, Model};
+use crate::model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model};
 use crate::source::{Pos, Sources};
 use crate::syntax::Orientation;
 
@@ -112,9 +121,21 @@ pub(crate) struct CollisionSpec {
     pub shape: Shape,
 }
 
+/// An `<inertial>`: `<mass value>` and all six `<inertia>` attributes are required, as in
+/// MuJoCo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InertialSpec {
+    pub origin: Origin,
+    pub mass: f64,
+    /// `ixx iyy izz ixy ixz iyz` (MuJoCo's `fullinertia` order).
+    pub inertia: [f64; 6],
+    pub pos: Pos,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct LinkSpec {
     pub name: String,
+    pub inertial: Option<InertialSpec>,
     pub collisions: Vec<CollisionSpec>,
     pub pos: Pos,
 }
@@ -155,6 +176,12 @@ pub(crate) struct JointSpec {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct MujocoSpec {
     pub fusestatic: Option<bool>,
+    /// `inertiafromgeom`: `Some(true)` for `true`, `Some(false)` for `false`, `None` for `auto`.
+    pub inertiafromgeom: Option<bool>,
+    pub boundmass: Option<f64>,
+    pub boundinertia: Option<f64>,
+    pub balanceinertia: Option<bool>,
+    pub settotalmass: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -321,6 +348,11 @@ impl Parser<'_> {
 
     fn link(&self, el: Node<'_, '_>) -> Result<LinkSpec, Error> {
         let name = self.required(el, "name")?.value().to_owned();
+        let mut inertials = elements(el).filter(|c| c.tag_name().name() == "inertial");
+        let inertial = inertials.next().map(|i| self.inertial(i)).transpose()?;
+        if let Some(second) = inertials.next() {
+            return Err(self.src.invalid(at(second), "repeated <inertial> in a link"));
+        }
         let mut collisions = Vec::new();
         for c in elements(el).filter(|c| c.tag_name().name() == "collision") {
             collisions.push(CollisionSpec {
@@ -329,7 +361,23 @@ impl Parser<'_> {
                 shape: self.shape(self.required_child(c, "geometry")?)?,
             });
         }
-        Ok(LinkSpec { name, collisions, pos: at(el) })
+        Ok(LinkSpec { name, inertial, collisions, pos: at(el) })
+    }
+
+    /// `<inertial>`: `<origin>`, `<mass value>` (not negative), `<inertia>` with all six
+    /// attributes.
+    fn inertial(&self, el: Node<'_, '_>) -> Result<InertialSpec, Error> {
+        let mass_attr = self.required(self.required_child(el, "mass")?, "value")?;
+        let [mass] = self.numbers::<1>(&mass_attr)?;
+        if mass < 0.0 {
+            return Err(self.src.invalid(attr_at(&mass_attr), "mass must not be negative"));
+        }
+        let node = self.required_child(el, "inertia")?;
+        let mut inertia = [0.0; 6];
+        for (slot, name) in inertia.iter_mut().zip(["ixx", "iyy", "izz", "ixy", "ixz", "iyz"]) {
+            [*slot] = self.numbers::<1>(&self.required(node, name)?)?;
+        }
+        Ok(InertialSpec { origin: self.origin(el)?, mass, inertia, pos: at(el) })
     }
 
     fn shape(&self, geometry: Node<'_, '_>) -> Result<Shape, Error> {
@@ -431,7 +479,8 @@ impl Parser<'_> {
         })
     }
 
-    /// `<mujoco><compiler .../></mujoco>`: only what changes the kinematic tree is read.
+    /// `<mujoco><compiler .../></mujoco>`: only what changes the kinematic tree or the
+    /// inertials is read.
     fn mujoco(&self, el: Node<'_, '_>, out: &mut MujocoSpec) -> Result<(), Error> {
         let Some(compiler) = child(el, "compiler") else { return Ok(()) };
         for a in compiler.attributes() {
@@ -443,8 +492,15 @@ impl Parser<'_> {
                     format!("attribute {}: \"{other}\" is not true or false", a.name()),
                 )),
             };
+            let number = || self.numbers::<1>(&a).map(|[v]| Some(v));
             match a.name() {
                 "fusestatic" => out.fusestatic = Some(flag()?),
+                "inertiafromgeom" if a.value() == "auto" => out.inertiafromgeom = None,
+                "inertiafromgeom" => out.inertiafromgeom = Some(flag()?),
+                "boundmass" => out.boundmass = number()?,
+                "boundinertia" => out.boundinertia = number()?,
+                "balanceinertia" => out.balanceinertia = Some(flag()?),
+                "settotalmass" => out.settotalmass = number()?,
                 "discardvisual" if !flag()? => {
                     return Err(self.src.unsupported(
                         attr_at(&a),
@@ -460,7 +516,7 @@ impl Parser<'_> {
                 "autolimits" if !flag()? => {
                     return Err(self.src.unsupported(attr_at(&a), "autolimits=\"false\""))
                 }
-                // angle (URDF is always radians), meshdir, inertia settings, ...
+                // angle (URDF is always radians), meshdir, inertiagrouprange, ...
                 _ => {}
             }
         }
@@ -520,6 +576,7 @@ pub(crate) fn build(urdf: &Urdf, src: &Sources, options: UrdfOptions) -> Result<
         ));
     }
     let mut b = Builder::new(urdf.name.clone(), src);
+    b.inertia_settings(&urdf.mujoco);
     // Where each link ended up: (body id, link frame in that body's frame).
     let mut placed: Vec<Option<(usize, Frame)>> = vec![None; urdf.links.len()];
     for &l in &tree.order {
@@ -540,9 +597,11 @@ pub(crate) fn build(urdf: &Urdf, src: &Sources, options: UrdfOptions) -> Result<
             joint.is_some_and(|j| j.kind != UrdfJointType::Fixed) || (l == tree.root && add_free);
         let is_world = link.name == "world";
         let (body, frame) = if is_world || (fuse && !moving) {
+            b.fuse_mass(link, parent_body, &parent_frame)?;
             (parent_body, parent_frame)
         } else {
             let id = b.body(&link.name, parent_body, parent_frame);
+            b.body_mass[id] = b.link_mass(link)?;
             if l == tree.root && add_free {
                 b.free_joint(&format!("{}_free_joint", link.name), id);
             } else if let Some(spec) = joint {
@@ -662,13 +721,29 @@ fn cycle_error(
     Error::Model { file: src.main_name(), message: "the links form a cycle".to_owned() }
 }
 
+/// What is known of a body's mass while static links are fused into it.
+#[derive(Debug, Clone, Copy)]
+enum Mass {
+    /// Nothing with mass yet.
+    Zero,
+    Known(Inertial),
+    /// A link without `<inertial>` but with collision geoms: MuJoCo gives it the geoms' mass
+    /// (density 1000, meshes by their volume), which is not computed here.
+    FromGeoms,
+}
+
 /// Accumulates the model: bodies and joints in order, geoms per body (MuJoCo appends the geoms
 /// of a merged link to its new body, so a body's geoms are its own, then its merged
-/// descendants' in depth-first order).
+/// descendants' in depth-first order), and each body's mass.
 struct Builder<'s> {
     src: &'s Sources,
     model: Model,
     body_geoms: Vec<Vec<Geom>>,
+    body_mass: Vec<Mass>,
+    inertia: InertiaOptions,
+    /// `inertiafromgeom="auto"`: a link without `<inertial>` weighs what its geoms do
+    /// (`"false"`: nothing).
+    geoms_weigh: bool,
     geom_names: HashSet<String>,
     /// Mesh name of each (file name stem, scale) seen, MuJoCo's naming: `stem`, `stem1`, ...
     meshes: Vec<(String, [f64; 3], String)>,
@@ -685,6 +760,7 @@ impl<'s> Builder<'s> {
             jnt_num: 0,
             dof_adr: 0,
             dof_num: 0,
+            inertial: None,
         };
         Builder {
             src,
@@ -708,6 +784,9 @@ impl<'s> Builder<'s> {
                 filter_parent: true,
             },
             body_geoms: vec![Vec::new()],
+            body_mass: vec![Mass::Zero],
+            inertia: InertiaOptions::default(),
+            geoms_weigh: true,
             geom_names: HashSet::new(),
             meshes: Vec::new(),
         }
@@ -724,10 +803,73 @@ impl<'s> Builder<'s> {
             jnt_num: 0,
             dof_adr: m.nv,
             dof_num: 0,
+            inertial: None,
         });
         m.body_last_dof.push(m.body_last_dof[parent]);
         self.body_geoms.push(Vec::new());
+        self.body_mass.push(Mass::Zero);
         m.bodies.len() - 1
+    }
+
+    /// The file's `<mujoco><compiler>` inertia attributes (MuJoCo's defaults when absent).
+    fn inertia_settings(&mut self, spec: &MujocoSpec) {
+        self.inertia = InertiaOptions {
+            from_geom: spec.inertiafromgeom == Some(true),
+            boundmass: spec.boundmass.unwrap_or(0.0),
+            boundinertia: spec.boundinertia.unwrap_or(0.0),
+            balance: spec.balanceinertia.unwrap_or(false),
+            total_mass: spec.settotalmass.filter(|&m| m > 0.0),
+        };
+        self.geoms_weigh = spec.inertiafromgeom != Some(false);
+    }
+
+    /// A link's own mass, its `<inertial>` in the link frame as `xml_urdf.cc` reads it (an
+    /// `<inertia>` that is all zeros counts as none given: a point mass) and `mjCBody::Compile`
+    /// checks it. Every link is checked, also one fused into the world, as MuJoCo does.
+    fn link_mass(&self, link: &LinkSpec) -> Result<Mass, Error> {
+        let Some(spec) = &link.inertial else {
+            let weighs = self.geoms_weigh && !link.collisions.is_empty();
+            return Ok(if weighs { Mass::FromGeoms } else { Mass::Zero });
+        };
+        let (quat, diag) = if spec.inertia == [0.0; 6] {
+            (UnitQuaternion::identity(), Vector3::zeros())
+        } else {
+            inertia::principal_axes(&inertia::full_matrix(spec.inertia))
+                .map_err(|e| self.src.invalid(spec.pos, format!("<inertia>: {e}")))?
+        };
+        // With inertiafromgeom="true" MuJoCo checks the geoms' inertia instead.
+        let (mass, diag) = if self.inertia.from_geom {
+            (spec.mass, diag)
+        } else {
+            inertia::bound_and_check(spec.mass, diag, &self.inertia)
+                .map_err(|e| self.src.invalid(spec.pos, e))?
+        };
+        let origin = origin_frame(&spec.origin);
+        Ok(Mass::Known(Inertial { mass, pos: origin.pos, quat: origin.quat * quat, diag }))
+    }
+
+    /// Fuses the static `link`, placed at `frame` in `body`, into the body's mass
+    /// (`mjCBody::AccumulateInertia`, for links of at least `mjMINVAL`); into the world it
+    /// adds nothing.
+    fn fuse_mass(&mut self, link: &LinkSpec, body: usize, frame: &Frame) -> Result<(), Error> {
+        let added = self.link_mass(link)?;
+        if body == 0 {
+            return Ok(());
+        }
+        let fused = |into: &Inertial, i: &Inertial| {
+            inertia::combine(into, &inertia::placed(i, &frame.pos, &frame.quat)).map_err(|e| {
+                let at = link.inertial.map_or(link.pos, |i| i.pos);
+                self.src.invalid(at, format!("link \"{}\" fused into its parent: {e}", link.name))
+            })
+        };
+        self.body_mass[body] = match (self.body_mass[body], added) {
+            (into, Mass::Zero) => into,
+            (Mass::FromGeoms, _) | (_, Mass::FromGeoms) => Mass::FromGeoms,
+            (into, Mass::Known(i)) if i.mass < MJ_MINVAL => into,
+            (Mass::Zero, Mass::Known(i)) => Mass::Known(fused(&NO_MASS, &i)?),
+            (Mass::Known(into), Mass::Known(i)) => Mass::Known(fused(&into, &i)?),
+        };
+        Ok(())
     }
 
     /// Appends a joint to `body` (the last body added) with its dofs and `qpos0`.
@@ -897,6 +1039,20 @@ impl<'s> Builder<'s> {
 
     fn finish(mut self) -> Model {
         let mut m = self.model;
+        // Bounds apply to every link before fusion, also to those without an inertial (whose
+        // masses come from geoms): not reproduced, so no inertials at all then.
+        let exact = !self.inertia.from_geom
+            && self.inertia.boundmass <= 0.0
+            && self.inertia.boundinertia <= 0.0;
+        for (body, mass) in m.bodies.iter_mut().zip(&self.body_mass) {
+            body.inertial = match mass {
+                Mass::Known(i) if exact => Some(*i),
+                _ => None,
+            };
+        }
+        if let Some(total) = self.inertia.total_mass {
+            inertia::set_total_mass(&mut m.bodies, total);
+        }
         m.geoms = self.body_geoms.drain(..).flatten().collect();
         m.jnt_pos_zero = vec![true; m.joints.len()];
         m.geom_mat = m.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
@@ -907,6 +1063,137 @@ impl<'s> Builder<'s> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const FIXED: UrdfOptions = UrdfOptions { base: UrdfBase::Fixed, fuse_static: None };
+
+    fn inertial_link(name: &str, xyz: &str, rpy: &str, mass: f64, i: [f64; 6]) -> String {
+        let [xx, yy, zz, xy, xz, yz] = i;
+        format!(
+            r#"<link name="{name}"><inertial><origin xyz="{xyz}" rpy="{rpy}"/><mass value="{mass}"/>
+               <inertia ixx="{xx}" iyy="{yy}" izz="{zz}" ixy="{xy}" ixz="{xz}" iyz="{yz}"/></inertial></link>"#
+        )
+    }
+
+    fn joint(name: &str, kind: &str, parent: &str, child: &str, origin: &str) -> String {
+        format!(
+            r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>
+               <origin {origin}/><axis xyz="0 0 1"/></joint>"#
+        )
+    }
+
+    /// With the `mujoco` feature: MuJoCo's URDF import of `urdf` gives the same model,
+    /// `inertials` bodies compared. Without it the hand numbers of each test stand alone.
+    fn matches_mujoco(m: &Model, urdf: &str, options: UrdfOptions, inertials: usize) {
+        #[cfg(feature = "mujoco")]
+        {
+            use crate::mujoco_check::{check_urdf_file, CheckOptions, INERTIAL_TOLERANCE};
+            // Tests run in parallel: one file per test (named by the test thread).
+            let thread = std::thread::current().name().unwrap_or("test").replace("::", "-");
+            let path =
+                std::env::temp_dir().join(format!("mjcf-{}-{thread}.urdf", std::process::id()));
+            std::fs::write(&path, urdf).unwrap();
+            let report = check_urdf_file(m, &path, options, CheckOptions { configs: 2, seed: 1 });
+            std::fs::remove_file(&path).ok();
+            let report = report.unwrap_or_else(|e| panic!("{e}"));
+            assert!(report.passes(INERTIAL_TOLERANCE), "{report}");
+            assert_eq!(report.inertials, inertials, "{report}");
+        }
+        #[cfg(not(feature = "mujoco"))]
+        let _ = (m, urdf, options, inertials);
+    }
+
+    /// Link `b` is fixed to `a` 0.3 m along x, turned 90° about z; its inertial sits 0.1 m
+    /// along its own x. In `a`'s frame: `b`'s centre at (0.3, 0.1, 0), its moments about x and
+    /// y swapped. `c` (massless point, no geoms) and `d` (zero mass) add nothing.
+    #[test]
+    fn fused_static_link_adds_its_inertia_to_the_parent() {
+        let urdf = [
+            r#"<robot name="r"><link name="base"/>"#.to_owned(),
+            inertial_link("a", "0 0 0", "0 0 0", 2.0, [0.1, 0.1, 0.1, 0.0, 0.0, 0.0]),
+            inertial_link("b", "0.1 0 0", "0 0 0", 1.0, [0.01, 0.02, 0.03, 0.0, 0.0, 0.0]),
+            r#"<link name="c"/>"#.to_owned(),
+            inertial_link("d", "0 0 0", "0 0 0", 0.0, [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]),
+            joint("ja", "revolute", "base", "a", r#"xyz="0 0 1""#),
+            joint("jb", "fixed", "a", "b", r#"xyz="0.3 0 0" rpy="0 0 1.5707963267948966""#),
+            joint("jc", "fixed", "b", "c", r#"xyz="1 2 3""#),
+            joint("jd", "fixed", "a", "d", r#"xyz="1 2 3""#),
+            "</robot>".to_owned(),
+        ]
+        .concat();
+        let m = Model::from_urdf_str(&urdf, FIXED).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.bodies.len(), 2);
+        let i = m.bodies[1].inertial.unwrap();
+        assert!((i.mass - 3.0).abs() < 1e-15);
+        assert!((i.pos - Vector3::new(0.1, 0.1 / 3.0, 0.0)).norm() < 1e-15, "{}", i.pos);
+        // About the centre of mass, by the parallel-axis theorem: a is (-0.1, -1/30, 0) from
+        // it with 2 kg, b (0.2, 1/15, 0) with 1 kg; Ixx = 0.1 + 2/900 + 0.02 + 4/900, ...
+        let expected = inertia::full_matrix([
+            0.12 + 6.0 / 900.0,
+            0.17,
+            0.13 + 2.0 * 0.1 / 9.0 + 0.04 / 9.0 + 0.04,
+            -0.02,
+            0.0,
+            0.0,
+        ]);
+        let t = inertia::tensor(&i);
+        assert!((t - expected).amax() < 1e-15, "{t}");
+        matches_mujoco(&m, &urdf, FIXED, 1);
+        // Unfused, each link keeps its own (b's and d's as written; base and c have none).
+        let apart = UrdfOptions { fuse_static: Some(false), ..FIXED };
+        let m = Model::from_urdf_str(&urdf, apart).unwrap_or_else(|e| panic!("{e}"));
+        let masses: Vec<_> = m.bodies.iter().map(|b| b.inertial.map(|i| i.mass)).collect();
+        assert_eq!(masses, [None, None, Some(2.0), Some(1.0), None, Some(0.0)]);
+        matches_mujoco(&m, &urdf, apart, 3);
+    }
+
+    /// A URDF `<inertia>` is a full tensor in the frame of the inertial's `<origin>`.
+    #[test]
+    fn urdf_inertia_is_diagonalised_in_its_origin_frame() {
+        let full = [3.0, 3.5, 4.0, 0.1, 0.2, 0.3];
+        let urdf = [
+            r#"<robot name="r">"#.to_owned(),
+            inertial_link("a", "0.1 0.2 0.3", "0.3 -0.2 0.5", 2.0, full),
+            "</robot>".to_owned(),
+        ]
+        .concat();
+        let m = Model::from_urdf_str(&urdf, UrdfOptions::default()).unwrap();
+        let i = m.bodies[1].inertial.unwrap();
+        let origin = origin_frame(&Origin { xyz: [0.1, 0.2, 0.3], rpy: [0.3, -0.2, 0.5] });
+        let r = origin.quat.to_rotation_matrix();
+        let expected = r.matrix() * inertia::full_matrix(full) * r.matrix().transpose();
+        assert!((inertia::tensor(&i) - expected).amax() < 1e-14);
+        assert_eq!((i.mass, i.pos), (2.0, origin.pos));
+        matches_mujoco(&m, &urdf, UrdfOptions::default(), 1);
+    }
+
+    /// What MuJoCo takes from geoms is not computed here: `None` then.
+    #[test]
+    fn inertials_from_geoms_are_none() {
+        let geom = r#"<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>"#;
+        let robot = |compiler: &str| {
+            [
+                format!(r#"<robot name="r"><mujoco><compiler {compiler}/></mujoco>"#),
+                inertial_link("a", "0 0 0", "0 0 0", 1.0, [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]),
+                format!(r#"<link name="b">{geom}</link>"#),
+                joint("jb", "fixed", "a", "b", r#"xyz="0 0 1""#),
+                "</robot>".to_owned(),
+            ]
+            .concat()
+        };
+        let options = UrdfOptions::default();
+        let inertial = |compiler: &str| {
+            let m = Model::from_urdf_str(&robot(compiler), options).unwrap();
+            m.bodies[1].inertial
+        };
+        // b's box weighs 8 kg in MuJoCo (density 1000): fused into a, a's mass is unknown here.
+        assert_eq!(inertial(""), None);
+        assert_eq!(inertial(r#"inertiafromgeom="true""#), None);
+        assert_eq!(inertial(r#"boundmass="0.1""#), None);
+        // inertiafromgeom="false": b's geom weighs nothing.
+        let m = Model::from_urdf_str(&robot(r#"inertiafromgeom="false""#), options).unwrap();
+        assert_eq!(m.bodies[1].inertial.map(|i| i.mass), Some(1.0));
+        matches_mujoco(&m, &robot(r#"inertiafromgeom="false""#), options, 1);
+    }
 
     fn builder_names(files: &[(&str, [f64; 3])]) -> Vec<String> {
         let src = Sources::default();

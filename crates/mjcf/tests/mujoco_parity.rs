@@ -1,6 +1,8 @@
 //! Our compiled models and kinematics against MuJoCo 3.17.0 itself (feature `mujoco`, needs
 //! `scripts/fetch-mujoco`): every reference MJCF and every model in the repo's `robots/`, and
-//! URDFs (ours in `tests/data/urdf`, the shared G1) against MuJoCo's own URDF import.
+//! URDFs (ours in `tests/data/urdf`, the shared G1) against MuJoCo's own URDF import. Every
+//! model's inertials are compared too, and every model here has some: a check cannot pass by
+//! comparing none.
 
 #![cfg(feature = "mujoco")]
 
@@ -9,10 +11,23 @@ mod shared;
 
 use std::path::{Path, PathBuf};
 
-use mjcf::mujoco_check::{check_file, check_urdf_file, CheckOptions, CollisionTolerances};
+use mjcf::mujoco_check::{
+    check_file, check_urdf_file, CheckOptions, CollisionTolerances, Report, INERTIAL_TOLERANCE,
+};
 use mjcf::{Model, UrdfBase, UrdfOptions};
 
 const TOLERANCE: f64 = 1e-9;
+
+/// The check's own mismatch threshold for inertials is the tolerance of these tests.
+#[test]
+fn inertial_tolerance_is_the_tests_tolerance() {
+    assert_eq!(INERTIAL_TOLERANCE, TOLERANCE);
+}
+
+/// Within the tolerance, and with inertials compared.
+fn passes(report: &Report) -> bool {
+    report.passes(TOLERANCE) && report.inertials > 0
+}
 
 fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -60,7 +75,7 @@ fn check(label: &str, path: &Path) -> Result<(), String> {
     let report =
         check_file(&model, path, CheckOptions::default()).map_err(|e| format!("{label}: {e}"))?;
     eprintln!("{label}: max deviation {:.2e}\n{report}", report.max_deviation());
-    if report.passes(TOLERANCE) {
+    if passes(&report) {
         Ok(())
     } else {
         Err(format!("{label} ({}): differs from mujoco\n{report}", path.display()))
@@ -113,13 +128,13 @@ fn urdf_variants() -> Vec<(&'static str, UrdfOptions)> {
     out
 }
 
-fn check_urdf(label: &str, path: &Path, urdf: UrdfOptions) -> Result<Model, String> {
+fn check_urdf(label: &str, path: &Path, urdf: UrdfOptions) -> Result<(Model, Report), String> {
     let model = Model::from_urdf_file(path, urdf).map_err(|e| format!("{label}: {e}"))?;
     let report = check_urdf_file(&model, path, urdf, CheckOptions::default())
         .map_err(|e| format!("{label}: {e}"))?;
-    eprintln!("{label}: max deviation {:.2e}", report.max_deviation());
-    if report.passes(TOLERANCE) {
-        Ok(model)
+    eprintln!("{label}: max deviation {:.2e}\n{report}", report.max_deviation());
+    if passes(&report) {
+        Ok((model, report))
     } else {
         Err(format!("{label} ({}): differs from mujoco\n{report}", path.display()))
     }
@@ -149,9 +164,13 @@ fn g1_urdf_matches_mujoco() {
     let mut failures = Vec::new();
     for (variant, urdf) in urdf_variants() {
         match check_urdf(&format!("g1 urdf ({variant})"), &path, urdf) {
-            Ok(model) => {
+            Ok((model, report)) => {
                 let free = usize::from(urdf.base == UrdfBase::Floating);
                 assert_eq!(model.joints.len(), 29 + free, "{variant}");
+                // Every link has an inertial or is a massless frame: fused, every body has one.
+                if urdf.fuse_static.is_none() {
+                    assert_eq!(report.inertials_skipped, 0, "{variant}\n{report}");
+                }
             }
             Err(e) => failures.push(e),
         }
@@ -167,7 +186,32 @@ fn check_file_dispatches_urdf() {
     assert_eq!(model.joints[0].kind, mjcf::JointType::Free);
     let report = check_file(&model, &path, CheckOptions { configs: 10, seed: 1 })
         .unwrap_or_else(|e| panic!("{e}"));
-    assert!(report.passes(TOLERANCE), "{report}");
+    assert!(passes(&report), "{report}");
+}
+
+/// A wrong mass, centre of mass or principal axis on one body is a mismatch naming it.
+#[test]
+fn inertial_check_catches_a_wrong_inertial() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/features/features.xml");
+    let model = Model::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    let root = model.body_id("root").expect("features.xml has a body root");
+    let turn = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), 1e-6);
+    for what in ["mass", "centre of mass", "axes"] {
+        let mut wrong = model.clone();
+        let i = wrong.bodies[root].inertial.as_mut().expect("root has an inertial");
+        match what {
+            "mass" => i.mass += 1e-7,
+            "centre of mass" => i.pos.y -= 1e-7,
+            _ => i.quat = turn * i.quat,
+        }
+        let report = check_file(&wrong, &path, CheckOptions { configs: 0, seed: 1 })
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(!report.passes(TOLERANCE), "{what}\n{report}");
+        assert!(
+            report.mismatches.iter().any(|m| m.contains("\"root\": inertial")),
+            "{what}\n{report}"
+        );
+    }
 }
 
 /// Without fusion, the floating joint of planar_floating.urdf hangs below the kept link

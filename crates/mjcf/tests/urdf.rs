@@ -274,6 +274,16 @@ fn errors_name_file_line_and_column() {
         format!("<joint name=\"{name}\" type=\"{kind}\"><parent link=\"{parent}\"/><child link=\"{child}\"/></joint>")
     };
     let robot = |body: &str| format!("<robot name=\"r\">{}\n{body}</robot>", link("a"));
+    // Link b, fixed to a (fused into it).
+    let inertial = |mass: &str, inertia: &str| {
+        format!(
+            "<link name=\"b\"><inertial>{mass}{inertia}</inertial></link>{}",
+            joint("k", "fixed", "a", "b")
+        )
+    };
+    const INERTIA: &str = "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>";
+    const ZERO_INERTIA: &str =
+        "<inertia ixx=\"0\" iyy=\"0\" izz=\"0\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>";
     let cases = [
         (robot(&joint("j", "revolute", "nope", "a")), "<string>:2:41: joint \"j\": parent link \"nope\" does not exist"),
         (robot(&joint("j", "revolute", "a", "nope")), "<string>:2:58: joint \"j\": child link \"nope\" does not exist"),
@@ -315,6 +325,25 @@ fn errors_name_file_line_and_column() {
          "<string>:2:19: unsupported: discardvisual=\"false\" (visual geoms are not read)"),
         (robot(&format!("{}{}", link("world"), joint("j", "fixed", "a", "world"))),
          "<string>:2:1: a link called \"world\" must be the root link"),
+        // <inertial>: MuJoCo's required elements and attributes, and its checks.
+        (robot(&inertial("", INERTIA)), "<string>:2:16: <inertial> without <mass>"),
+        (robot(&inertial("<mass value=\"1\"/>", "")), "<string>:2:16: <inertial> without <inertia>"),
+        (robot(&inertial("<mass/>", INERTIA)), "<string>:2:26: <mass> without the required attribute value"),
+        (robot(&inertial("<mass value=\"-1\"/>", INERTIA)), "<string>:2:32: mass must not be negative"),
+        (robot(&inertial("<mass value=\"abc\"/>", INERTIA)), "<string>:2:32: attribute value: \"abc\" is not a finite number"),
+        (robot(&inertial("<mass value=\"1 2\"/>", INERTIA)), "<string>:2:32: attribute value needs 1 numbers, got \"1 2\""),
+        (robot(&inertial("<mass value=\"1\"/>", "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixz=\"0\" iyz=\"0\"/>")),
+         "<string>:2:43: <inertia> without the required attribute ixy"),
+        (robot(&format!("<link name=\"b\"><inertial><mass value=\"1\"/>{INERTIA}</inertial><inertial/></link>")),
+         "<string>:2:112: repeated <inertial> in a link"),
+        (robot(&inertial("<mass value=\"1\"/>", "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"2\" ixz=\"0\" iyz=\"0\"/>")),
+         "<string>:2:16: <inertia>: inertia must have positive eigenvalues"),
+        (robot(&inertial("<mass value=\"1\"/>", "<inertia ixx=\"1\" iyy=\"1\" izz=\"3\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>")),
+         "<string>:2:16: inertia must satisfy A + B >= C; use 'balanceinertia' to fix"),
+        // A point mass (all-zero <inertia>) fused into a massless body has no principal axes.
+        (robot(&inertial("<mass value=\"1\"/>", ZERO_INERTIA)),
+         "<string>:2:16: link \"b\" fused into its parent: inertia must have positive eigenvalues"),
+        (robot("<mujoco><compiler boundmass=\"x\"/></mujoco>"), "<string>:2:19: attribute boundmass: \"x\" is not a finite number"),
     ];
     for (urdf, expected) in &cases {
         let message = match Model::from_urdf_str(urdf, UrdfOptions::default()) {
