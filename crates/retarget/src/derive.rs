@@ -742,7 +742,8 @@ struct SoleGeom {
     rot: UnitQuaternion<f64>,
 }
 
-/// The soles' primitives ([`RobotRoles::soles`]) per foot role, in the foot's canonical frame.
+/// The soles' primitives ([`RobotRoles::soles`]) per foot role, in the foot's canonical frame;
+/// a foot without collision geometry gets its equivalent inertia box, as the planner does.
 fn sole_geoms(
     model: &Model,
     data: &Data,
@@ -767,6 +768,23 @@ fn sole_geoms(
                 })
             })
             .collect::<Vec<_>>();
+        let geoms = if geoms.is_empty() {
+            // No collision geometry: the foot's equivalent inertia box, as the planner's.
+            crate::feet::inertia_sole(model, sole.body)
+                .and_then(|(b, size, rel)| {
+                    let (at, rot) = (data.xpos.get(b)?, data.xquat.get(b)?);
+                    let box_pos = at + rot * rel.translation.vector;
+                    Some(vec![SoleGeom {
+                        kind: mjcf::GeomType::Box,
+                        size,
+                        pos: c.inverse() * (box_pos - data.xpos.get(sole.body)?),
+                        rot: c.inverse() * rot * rel.rotation,
+                    }])
+                })
+                .unwrap_or_default()
+        } else {
+            geoms
+        };
         if !geoms.is_empty() {
             out.insert(role, geoms);
         }

@@ -16,8 +16,10 @@
 //!   `|q[t+1] − 2 q[t] + q[t−1]| / Δt²` (rad/s² or m/s²). Hinge and slide joints only.
 //! - **Feet**: the foot height `h` in a frame is the lowest point of the foot's primitive
 //!   collision geoms (sphere, capsule, cylinder, ellipsoid, box on the foot body or its
-//!   descendants) above the ground plane `z = ground_height`, or the height of the foot body's
-//!   origin when it has none. The foot's horizontal velocity `v` at frame t is that of its
+//!   descendants) above the ground plane `z = ground_height`; for a foot without any, the
+//!   lowest point of the uniform box with its mass and inertia (the planner's sole for such a
+//!   foot, `feet::inertia_sole`), or the height of the foot body's origin when it has no
+//!   inertial either. The foot's horizontal velocity `v` at frame t is that of its
 //!   **contact point**: the point of the foot body that is lowest at frame t (the body origin
 //!   without geoms), followed as a point fixed in the body over the frames around t (`gradient`
 //!   scheme). A foot rolling over its heel or toes without slipping keeps that point still;
@@ -83,6 +85,7 @@ use std::fmt;
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
 use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses, Error};
 
@@ -199,7 +202,8 @@ pub struct JointMotion {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FootReport {
     pub body: String,
-    /// `"geoms"` (lowest point of its collision geoms) or `"origin"` (body origin).
+    /// `"geoms"` (lowest point of its collision geoms), `"inertia"` (of the equivalent box of
+    /// its mass and inertia, for a foot without geoms) or `"origin"` (body origin).
     pub height_from: &'static str,
     pub contact_frames: usize,
     pub contact_phases: usize,
@@ -364,8 +368,8 @@ pub fn report(
     let heights = feet.map(|f| foot_heights(motion, model, f, opts.ground_height));
     let feet_reports: Vec<FootReport> = (0..2)
         .map(|i| {
-            let (h, low, from_geoms) = &heights[i];
-            foot_report(model, &poses, feet[i], h, low, *from_geoms, motion.fps, opts)
+            let (h, low, from) = &heights[i];
+            foot_report(model, &poses, feet[i], h, low, *from, motion.fps, opts)
         })
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
@@ -602,14 +606,22 @@ pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
     }
 }
 
+/// What a foot's height is measured at ([`FootReport::height_from`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum HeightFrom {
+    Geoms,
+    Inertia,
+    Origin,
+}
+
 /// Per frame foot height above the ground, the lowest point of the foot (world; the body
-/// origin without geoms), and whether they come from geoms.
+/// origin without geoms or inertial), and what they were measured at.
 fn foot_heights(
     motion: &RobotMotion,
     model: &mjcf::Model,
     foot: usize,
     ground: f64,
-) -> (Vec<f64>, Vec<Vector3<f64>>, bool) {
+) -> (Vec<f64>, Vec<Vector3<f64>>, HeightFrom) {
     let in_foot = |mut b: usize| loop {
         if b == foot {
             return true;
@@ -622,10 +634,18 @@ fn foot_heights(
     let geoms: Vec<usize> = (0..model.geoms.len())
         .filter(|&g| in_foot(model.geoms[g].body) && model.geoms[g].kind.is_primitive())
         .collect();
+    // Without geoms, the foot's equivalent inertia box, as the planner's sole.
+    let inertia = if geoms.is_empty() { crate::feet::inertia_sole(model, foot) } else { None };
     let mut data = mjcf::Data::new(model);
     let lowest: Vec<Vector3<f64>> = (0..motion.num_frames())
         .map(|t| {
             model.kinematics(motion.frame(t), &mut data);
+            if let Some((b, size, rel)) = &inertia {
+                let rot = data.xquat[*b] * rel.rotation;
+                let centre = data.xpos[*b] + data.xquat[*b] * rel.translation.vector;
+                let r = rot.to_rotation_matrix().into_inner();
+                return centre + support_offset(mjcf::GeomType::Box, size, &r);
+            }
             geoms
                 .iter()
                 .filter_map(|&g| mjcf::geom_lowest_point(model, &data, g))
@@ -634,7 +654,12 @@ fn foot_heights(
         })
         .collect();
     let heights = lowest.iter().map(|p| p.z - ground).collect();
-    (heights, lowest, !geoms.is_empty())
+    let from = match (geoms.is_empty(), inertia.is_some()) {
+        (false, _) => HeightFrom::Geoms,
+        (true, true) => HeightFrom::Inertia,
+        (true, false) => HeightFrom::Origin,
+    };
+    (heights, lowest, from)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -644,7 +669,7 @@ fn foot_report(
     foot: usize,
     heights: &[f64],
     lowest: &[Vector3<f64>],
-    from_geoms: bool,
+    from: HeightFrom,
     fps: f64,
     opts: &ReportOptions,
 ) -> FootReport {
@@ -688,7 +713,11 @@ fn foot_report(
     let penetration: Vec<f64> = heights.iter().filter(|h| **h < 0.0).map(|h| -h * 100.0).collect();
     FootReport {
         body: model.bodies[foot].name.clone(),
-        height_from: if from_geoms { "geoms" } else { "origin" },
+        height_from: match from {
+            HeightFrom::Geoms => "geoms",
+            HeightFrom::Inertia => "inertia",
+            HeightFrom::Origin => "origin",
+        },
         contact_frames,
         contact_phases: slides.len(),
         sliding_frames,

@@ -328,32 +328,18 @@ fn every_reference_robot_walks_the_lafan1_walk() {
         let checks = run(&model, &name.display().to_string(), &bvh, None);
         assert_eq!(checks.choice, Choice::Derived);
         assert_sane(&name.display().to_string(), &checks, true);
-        // Planted feet, where the feet have collision geometry to plant (N1's, Hi's and the
-        // H1-2's and GMR's H1 models have none). Before soles of bars and balls stood on
-        // points of their own and Adam Lite's ankle link was taken for its foot: the G1
-        // MJCFs skated in 4.7 % of the walk, the H1 in 6.9 %, Adam Lite's soles were in the
-        // band in 6 % of stance.
-        let soles = retarget::RobotRoles::recognise(&model).unwrap().soles;
-        let primitives = retarget::constraints::collision_primitives(&model);
-        let under = |mut b: usize, sole: usize| loop {
-            if b == sole {
-                return true;
-            }
-            if b == 0 {
-                return false;
-            }
-            b = model.bodies[b].parent;
-        };
-        let geoms =
-            soles.iter().all(|s| primitives.iter().any(|&g| under(model.geoms[g].body, s.body)));
-        if geoms {
-            let (skate, band) = checks.feet_on_floor.expect("source contacts");
-            assert!(
-                skate <= 0.02 && band >= 0.9,
-                "{}: skating {skate}, sole in band {band}",
-                name.display()
-            );
-        }
+        // Planted feet on every robot: on soles of collision geometry, or of the feet's
+        // mass and inertia where they have none (N1's, Hi's and the H1-2's and GMR's H1
+        // models: skating 6–12 % of the walk before, unplanted). Before soles of bars and
+        // balls stood on points of their own and Adam Lite's ankle link was taken for its
+        // foot: the G1 MJCFs skated in 4.7 % of the walk, the H1 in 6.9 %, Adam Lite's soles
+        // were in the band in 6 % of stance.
+        let (skate, band) = checks.feet_on_floor.expect("source contacts");
+        assert!(
+            skate <= 0.02 && band >= 0.9,
+            "{}: skating {skate}, sole in band {band}",
+            name.display()
+        );
     }
 }
 
