@@ -614,7 +614,16 @@ fn urdf_tree(u: &mut Unstructured<'_>, wild: bool) -> Result<Vec<u8>> {
     for k in 0..links {
         let _ = write!(out, "<link name=\"l{k}\">");
         if u.arbitrary()? {
-            let (m, i) = (numbers(u, 1)?, numbers(u, 6)?);
+            let m = numbers(u, 1)?;
+            // Clean files have inertias MuJoCo accepts (positive moments that satisfy the
+            // triangle inequality: here equal, with no products); wild ones arbitrary tensors,
+            // which the reader rejects as MuJoCo does, mostly.
+            let i = if wild {
+                numbers(u, 6)?
+            } else {
+                let moment = numbers(u, 1)?;
+                format!("{moment} {moment} {moment} 0 0 0")
+            };
             let i: Vec<&str> = i.split(' ').collect();
             let _ = write!(
                 out,
