@@ -771,14 +771,13 @@ fn sole_geoms(
         let geoms = if geoms.is_empty() {
             // No collision geometry: the foot's equivalent inertia box, as the planner's.
             crate::feet::inertia_sole(model, sole.body)
-                .and_then(|(b, size, rel)| {
-                    let (at, rot) = (data.xpos.get(b)?, data.xquat.get(b)?);
-                    let box_pos = at + rot * rel.translation.vector;
+                .and_then(|inertia| {
+                    let at = inertia.world(data);
                     Some(vec![SoleGeom {
                         kind: mjcf::GeomType::Box,
-                        size,
-                        pos: c.inverse() * (box_pos - data.xpos.get(sole.body)?),
-                        rot: c.inverse() * rot * rel.rotation,
+                        size: inertia.half,
+                        pos: c.inverse() * (at.translation.vector - data.xpos.get(sole.body)?),
+                        rot: c.inverse() * at.rotation,
                     }])
                 })
                 .unwrap_or_default()

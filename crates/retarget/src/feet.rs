@@ -180,9 +180,11 @@ impl RobotFoot {
             })
             .collect();
         if sole.is_empty() {
-            let (b, size, rel) = inertia_sole(model, sole_body)?;
-            let at = pose_of(&data.xpos[b], &data.xmat[b]) * rel;
-            sole.push((GeomType::Box, size, inverse * at));
+            // (From `xmat`, as the geoms' poses here, not `world`'s `xquat`: the two differ
+            // by rounding, which the solve can carry to 1e-4 rad on the N1 mocap's walk.)
+            let inertia = inertia_sole(model, sole_body)?;
+            let at = pose_of(&data.xpos[inertia.body], &data.xmat[inertia.body]) * inertia.pose;
+            sole.push((GeomType::Box, inertia.half, inverse * at));
         }
         let forward = data.xmat[body].transpose() * Vector3::x();
         let corners = sole
@@ -347,16 +349,31 @@ const INERTIA_SOLE_HALF_LENGTH: [f64; 2] = [0.03, 0.2];
 
 /// A sole for a foot without collision geometry (the motion-capture models of the N1, the
 /// H1, the H1-2, the Hi have bodies with masses and nothing else): the uniform box with the
-/// mass and principal moments of the heaviest body at or below `sole_body` whose box has a
-/// foot's length ([`INERTIA_SOLE_HALF_LENGTH`] for its longest half side), as `(body, half
-/// sizes, pose in that body's frame)`. The N1's foot gives 19 × 6.8 × 3.4 cm with its bottom
-/// 4.9 cm below the ankle axis; a real sole's mass sits higher than its middle (motors,
-/// ankle), so the box's bottom is a little above the real sole, which the floor shift of
-/// [`plan`] takes up. `None` when no body there has an inertial.
-pub(crate) fn inertia_sole(
-    model: &Model,
-    sole_body: usize,
-) -> Option<(usize, [f64; 3], Isometry3<f64>)> {
+/// mass and principal moments of a body at or below the foot ([`inertia_sole`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InertiaSole {
+    pub body: usize,
+    /// Half sizes along the principal axes (m).
+    pub half: [f64; 3],
+    /// The box's pose in `body`'s frame: centre of mass and principal axes.
+    pub pose: Isometry3<f64>,
+}
+
+impl InertiaSole {
+    /// The box's world pose with `data`'s kinematics.
+    pub fn world(&self, data: &Data) -> Isometry3<f64> {
+        let body = Translation3::from(data.xpos[self.body]);
+        Isometry3::from_parts(body, data.xquat[self.body]) * self.pose
+    }
+}
+
+/// The [`InertiaSole`] of the heaviest body at or below `sole_body` whose box has a foot's
+/// length ([`INERTIA_SOLE_HALF_LENGTH`] for its longest half side). The N1's foot gives
+/// 19 × 6.8 × 3.4 cm with its bottom 4.9 cm below the ankle axis; a real sole's mass sits
+/// higher than its middle (motors, ankle), so the box's bottom is a little above the real
+/// sole, which the floor shift of [`plan`] takes up. `None` when no body there has an
+/// inertial.
+pub(crate) fn inertia_sole(model: &Model, sole_body: usize) -> Option<InertiaSole> {
     (0..model.bodies.len())
         .filter(|&b| is_descendant(model, b, sole_body))
         .filter_map(|b| {
@@ -367,9 +384,10 @@ pub(crate) fn inertia_sole(
             (long >= shortest && long <= longest).then_some((b, inertial, half))
         })
         .max_by(|a, b| a.1.mass.total_cmp(&b.1.mass))
-        .map(|(b, inertial, half)| {
-            let pose = Isometry3::from_parts(Translation3::from(inertial.pos), inertial.quat);
-            (b, [half.x, half.y, half.z], pose)
+        .map(|(body, inertial, half)| InertiaSole {
+            body,
+            half: [half.x, half.y, half.z],
+            pose: Isometry3::from_parts(Translation3::from(inertial.pos), inertial.quat),
         })
 }
 

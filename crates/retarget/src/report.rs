@@ -622,29 +622,28 @@ fn foot_heights(
     foot: usize,
     ground: f64,
 ) -> (Vec<f64>, Vec<Vector3<f64>>, HeightFrom) {
-    let in_foot = |mut b: usize| loop {
-        if b == foot {
-            return true;
-        }
-        if b == 0 {
-            return false;
-        }
-        b = model.bodies[b].parent;
-    };
     let geoms: Vec<usize> = (0..model.geoms.len())
-        .filter(|&g| in_foot(model.geoms[g].body) && model.geoms[g].kind.is_primitive())
+        .filter(|&g| {
+            let geom = &model.geoms[g];
+            crate::feet::is_descendant(model, geom.body, foot) && geom.kind.is_primitive()
+        })
         .collect();
     // Without geoms, the foot's equivalent inertia box, as the planner's sole.
     let inertia = if geoms.is_empty() { crate::feet::inertia_sole(model, foot) } else { None };
+    let from = match (geoms.is_empty(), inertia.is_some()) {
+        (false, _) => HeightFrom::Geoms,
+        (true, true) => HeightFrom::Inertia,
+        (true, false) => HeightFrom::Origin,
+    };
     let mut data = mjcf::Data::new(model);
     let lowest: Vec<Vector3<f64>> = (0..motion.num_frames())
         .map(|t| {
             model.kinematics(motion.frame(t), &mut data);
-            if let Some((b, size, rel)) = &inertia {
-                let rot = data.xquat[*b] * rel.rotation;
-                let centre = data.xpos[*b] + data.xquat[*b] * rel.translation.vector;
-                let r = rot.to_rotation_matrix().into_inner();
-                return centre + support_offset(mjcf::GeomType::Box, size, &r);
+            if let Some(inertia) = &inertia {
+                let at = inertia.world(&data);
+                let r = at.rotation.to_rotation_matrix().into_inner();
+                return at.translation.vector
+                    + support_offset(mjcf::GeomType::Box, &inertia.half, &r);
             }
             geoms
                 .iter()
@@ -654,11 +653,6 @@ fn foot_heights(
         })
         .collect();
     let heights = lowest.iter().map(|p| p.z - ground).collect();
-    let from = match (geoms.is_empty(), inertia.is_some()) {
-        (false, _) => HeightFrom::Geoms,
-        (true, true) => HeightFrom::Inertia,
-        (true, false) => HeightFrom::Origin,
-    };
     (heights, lowest, from)
 }
 
