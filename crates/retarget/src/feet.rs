@@ -19,12 +19,15 @@
 //!    source's yaw about its toe point (which stays on the anchor), as a foot turning on its
 //!    ball does, instead of holding the mean yaw and twisting the leg by half the turn.
 //! 3. **Blending**: for [`FootPlanOptions::blend_s`] before touch-down and after lift-off the
-//!    target moves linearly (slerp for orientations) between the planted pose and the free
-//!    one, and so does the weight, so the foot neither jumps onto its anchor nor off it.
+//!    planted pose's offset from the free target (position and yaw, taken at the edge) fades
+//!    out along a smoothstep, and so does the weight, so the foot neither jumps onto its
+//!    anchor nor off it. With the same weight, a share ([`FootPlanOptions::ease`], a quarter)
+//!    of the free target's horizontal motion since lift-off (until touch-down) is held back,
+//!    so the foot leaves the floor and lands slower than the human's foot does.
 //! 4. **Swing clearance**: out of stance the target's sole stays at least
 //!    [`FootPlanOptions::swing_clearance`] above the floor. It rises to that height over
 //!    [`FootPlanOptions::lift_s`] after lift-off and comes down from it over the same time
-//!    before touch-down. While it rises or comes down it is held over its anchor, so it lifts
+//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames. While it rises or comes down it is held over its anchor, so it lifts
 //!    off before it moves and moves before it comes down. A foot is then either on the
 //!    floor and still, or clear of it. Without this, the swing foot skims the floor at the
 //!    start and end of every step, a few millimetres up and moving at a few dm/s.
@@ -86,6 +89,19 @@ pub struct FootPlanOptions {
     /// Time (s) over which the swing clearance fades in after lift-off and out before
     /// touch-down (smoothstep).
     pub lift_s: f64,
+    /// Extra height (m) of the swing clearance in the frames within [`FootPlanOptions::lift_s`]
+    /// of a lift-off or touch-down. The smoothing pass averages such a frame with its planted
+    /// neighbour, which left the sole at the report's 3 cm contact height instead of 3.2 cm
+    /// (median over the T1's LAFAN1 walk), a low, moving frame that counted as sliding.
+    pub lift_margin: f64,
+    /// How much of the free target's horizontal motion since lift-off (until touch-down) the
+    /// blend ([`FootPlanOptions::blend_s`]) holds back, weighted as the planted offset is: 0
+    /// adds the planted offset to the moving free target, so the foot leaves the floor at
+    /// the human foot's speed; 1 moves it from the held footprint to the free target, so it
+    /// leaves at rest and lags. A foot that leaves at speed moves its contact point in the
+    /// frame after its last planted one, which the report's central differences count as
+    /// sliding in that planted frame.
+    pub ease: f64,
     /// A stance phase over which the source foot's yaw turns through more than this (rad,
     /// largest minus smallest) is a **pivot**: the planted foot turns with the source's, about
     /// its toe point ([`RobotFoot::toe_point`]), which stays where the anchor puts it. Holding the mean yaw there
@@ -109,6 +125,8 @@ impl Default for FootPlanOptions {
             sole_gap: 0.03,
             swing_clearance: 0.032,
             lift_s: 1.0 / 30.0,
+            lift_margin: 0.003,
+            ease: 0.25,
             pivot_turn: 45f64.to_radians(),
         }
     }
@@ -521,13 +539,14 @@ pub fn plan(
             }
         }
         let edges = swing_edges(&held.iter().map(Option::is_some).collect::<Vec<_>>());
+        let lift_frames = (options.lift_s * fps).ceil();
         for t in 0..frames {
             if held[t].is_some() {
                 weight[t][side] = options.stance_weight;
                 continue;
             }
             let (mut pose, w) = if ramp[t].weight > 0.0 {
-                (ramp[t].apply(&free[t]), ramp[t].weight.min(1.0))
+                (ramp[t].apply(&free[t], options.ease), ramp[t].weight.min(1.0))
             } else {
                 (free[t], 0.0)
             };
@@ -544,8 +563,10 @@ pub fn plan(
                         changed = true;
                     }
                 }
-                let low =
-                    options.swing_clearance * rise - pose.pos.z - foot.sole_offset(&quat(&pose));
+                let margin =
+                    if frames_off as f64 <= lift_frames { options.lift_margin } else { 0.0 };
+                let height = (options.swing_clearance + margin) * rise;
+                let low = height - pose.pos.z - foot.sole_offset(&quat(&pose));
                 if low > 0.0 {
                     pose.pos.z += low;
                     changed = true;
@@ -726,10 +747,12 @@ fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2]
     }
 }
 
-/// An offset of a foot target (position and yaw), accumulated with weights.
+/// An offset of a foot target (position and yaw), accumulated with weights, with the free
+/// target's position where the offset was taken (for [`FootPlanOptions::ease`]).
 #[derive(Debug, Clone, Copy, Default)]
 struct Ramp {
     pos: Vector3<f64>,
+    from: Vector3<f64>,
     yaw: f64,
     weight: f64,
 }
@@ -738,19 +761,25 @@ impl Ramp {
     /// The offset that turns `free` into `planted`.
     fn between(foot: &RobotFoot, free: &Pose, planted: &Pose) -> Ramp {
         let yaw = wrap(foot.yaw(&quat(planted)) - foot.yaw(&quat(free)));
-        Ramp { pos: planted.pos - free.pos, yaw, weight: 1.0 }
+        Ramp { pos: planted.pos - free.pos, from: free.pos, yaw, weight: 1.0 }
     }
 
     fn add(&mut self, other: &Ramp, w: f64) {
         self.pos += other.pos * w;
+        self.from += other.from * w;
         self.yaw += other.yaw * w;
         self.weight += w;
     }
 
-    fn apply(&self, free: &Pose) -> Pose {
+    /// `free` moved by the offset, less `ease` times the free target's horizontal motion
+    /// since the offset was taken (weighted alike; normalised where two edges' blends
+    /// overlap, so it never extrapolates).
+    fn apply(&self, free: &Pose, ease: f64) -> Pose {
         let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.yaw);
         let q = turn * quat(free);
-        Pose { quat: [q.w, q.i, q.j, q.k], pos: free.pos + self.pos }
+        let mut held = (free.pos * self.weight - self.from) * (ease / self.weight.max(1.0));
+        held.z = 0.0;
+        Pose { quat: [q.w, q.i, q.j, q.k], pos: free.pos + self.pos - held }
     }
 }
 
