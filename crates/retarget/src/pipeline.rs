@@ -421,15 +421,22 @@ impl<'a> Prepared<'a> {
                     // went far enough to leave a geom in the floor, the first pass's pose
                     // (which held every constraint) stays.
                     // (A short step stays where the rows describe it: nothing to check.)
-                    let moved = solver.qpos().iter().zip(reference).map(|(a, b)| (a - b).abs());
-                    let far = moved.fold(0.0, f64::max) > REPAIR_TRUSTED_STEP;
+                    // (Also where the smoothing moved the pose far from the first pass: a
+                    // first pass that jumps between two frames, e.g. a foot passing the other,
+                    // smooths to a pose between them, which may be deep in the robot and too
+                    // deep for one repair step.)
+                    let first_pass = &qpos[k * nq..(k + 1) * nq];
+                    let apart = |a: &[f64], b: &[f64]| {
+                        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+                    };
+                    let far = apart(solver.qpos(), reference) > REPAIR_TRUSTED_STEP
+                        || apart(reference, first_pass) > REPAIR_TRUSTED_STEP;
                     let depth = if far {
                         violation(self.model, solver.data(), &ground, &pairs, p.floor)
                     } else {
                         0.0
                     };
                     if depth > REPAIR_SLACK {
-                        let first_pass = &qpos[k * nq..(k + 1) * nq];
                         self.model.kinematics(first_pass, &mut scratch);
                         if violation(self.model, &scratch, &ground, &pairs, p.floor) < depth {
                             solver.keep(first_pass)?;
@@ -715,9 +722,10 @@ fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize) -> Vec<f64> {
 /// other before the first pass's pose is kept instead (the report counts from 1 cm).
 const REPAIR_SLACK: f64 = 0.002;
 
-/// A repair step that moves no coordinate further than this (rad or m) from the smoothed pose
-/// is not checked: its linearised rows still describe where it ends (the first pass makes
-/// its rows again beyond the same distance).
+/// A repair step that moves no coordinate further than this (rad or m) from the smoothed pose,
+/// from a smoothed pose as close to the first pass's, is not checked: its linearised rows
+/// still describe where it ends (the first pass makes its rows again beyond the same
+/// distance), and it starts where the first pass held every constraint.
 const REPAIR_TRUSTED_STEP: f64 = 0.02;
 
 /// The deepest violation (m) in `data`: of the lowest of `geoms` below `floor`, and of any of
