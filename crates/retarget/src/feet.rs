@@ -1013,6 +1013,10 @@ mod tests {
     /// first and last third of a 1 s clip, in between it moves 0.5 m forward barely off the
     /// floor (1 cm at most). Returns the planned foot targets and the contact labels.
     fn low_step(fps: f64) -> (Vec<Pose>, Vec<bool>, FootPlan) {
+        low_step_with(fps, &FootPlanOptions::default())
+    }
+
+    fn low_step_with(fps: f64, options: &FootPlanOptions) -> (Vec<Pose>, Vec<bool>, FootPlan) {
         let mut foot = box_foot();
         foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
         let frames = fps as usize;
@@ -1027,9 +1031,27 @@ mod tests {
             })
             .collect();
         let contacts = FootContacts { left: labels.clone(), right: vec![false; frames] };
-        let plan =
-            plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, &FootPlanOptions::default());
+        let plan = plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, options);
         (targets, labels, plan)
+    }
+
+    #[test]
+    fn swing_feet_leave_and_land_slower_than_the_human_foot() {
+        let eased = FootPlanOptions::default();
+        let free = FootPlanOptions { ease: 0.0, ..eased.clone() };
+        let (a, labels, _) = low_step_with(30.0, &eased);
+        let (b, _, _) = low_step_with(30.0, &free);
+        let lift = labels.iter().position(|c| !c).unwrap_or(0);
+        let touch = lift + labels[lift..].iter().position(|c| *c).unwrap_or(0);
+        // A step soon after lift-off, and one soon before the (led) touch-down.
+        for (from, to) in [(lift, lift + 1), (touch - 3, touch - 2)] {
+            let (da, db) = (a[to].pos.x - a[from].pos.x, b[to].pos.x - b[from].pos.x);
+            assert!(db > 0.0 && da > 0.0 && da < 0.9 * db, "{from}->{to}: {da} vs {db}");
+        }
+        let mid = (lift + touch) / 2;
+        // The margin: the rise frame's sole is above the clearance plus the margin.
+        assert!(a[lift].pos.z - 0.02 >= eased.swing_clearance + eased.lift_margin - 1e-9);
+        assert!(a[mid].pos.z - 0.02 < eased.swing_clearance + 1e-9);
     }
 
     #[test]
