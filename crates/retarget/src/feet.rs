@@ -27,10 +27,11 @@
 //! 4. **Swing clearance**: out of stance the target's sole stays at least
 //!    [`FootPlanOptions::swing_clearance`] above the floor. It rises to that height over
 //!    [`FootPlanOptions::lift_s`] after lift-off and comes down from it over the same time
-//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames. While it rises or comes down it is held over its anchor, so it lifts
-//!    off before it moves and moves before it comes down. A foot is then either on the
-//!    floor and still, or clear of it. Without this, the swing foot skims the floor at the
-//!    start and end of every step, a few millimetres up and moving at a few dm/s.
+//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames. While it
+//!    rises or comes down it is held over its anchor, so it lifts off before it moves and
+//!    moves before it comes down. A foot is then either on the floor and still, or clear of
+//!    it. Without this, the swing foot skims the floor at the start and end of every step, a
+//!    few millimetres up and moving at a few dm/s.
 //!
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body; a foot without collision geometry stands on the
@@ -1048,8 +1049,9 @@ mod tests {
             let (da, db) = (a[to].pos.x - a[from].pos.x, b[to].pos.x - b[from].pos.x);
             assert!(db > 0.0 && da > 0.0 && da < 0.9 * db, "{from}->{to}: {da} vs {db}");
         }
+        // The margin: the rise frame's sole is at the clearance plus the margin, mid-swing
+        // (the free target 1 cm up) at the clearance alone.
         let mid = (lift + touch) / 2;
-        // The margin: the rise frame's sole is above the clearance plus the margin.
         assert!(a[lift].pos.z - 0.02 >= eased.swing_clearance + eased.lift_margin - 1e-9);
         assert!(a[mid].pos.z - 0.02 < eased.swing_clearance + 1e-9);
     }
