@@ -737,14 +737,17 @@ impl<'m> Solver<'m> {
     /// Moves the solution of the frame just solved to `reference` (same frame; e.g. the
     /// trajectory smoothed in time), then corrects it for the constraints and this frame's
     /// point tasks with `steps` steps that otherwise stay close to `reference` (weight
-    /// `weight` per dof). The next frame's speed limits count from the result.
+    /// `weight` per dof). The next frame's speed limits count from the result. Returns how
+    /// many of its steps had to relax constraints that could not all hold together (as
+    /// [`FrameDiagnostics::relaxed_steps`]): a step that dropped the self-collision rows may
+    /// end with geoms in each other.
     pub fn repair_frame(
         &mut self,
         reference: &[f64],
         weight: f64,
         steps: usize,
         dt: f64,
-    ) -> Result<(), Error> {
+    ) -> Result<usize, Error> {
         if reference.len() != self.model.nq || reference.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidOption(format!(
                 "a reference configuration must be {} finite numbers",
@@ -753,6 +756,7 @@ impl<'m> Solver<'m> {
         }
         self.qpos.copy_from_slice(reference);
         self.rows_made = false;
+        self.relaxed_steps = 0;
         self.model.kinematics(&self.qpos, &mut self.data);
         for _ in 0..steps {
             self.qp.h.fill(0.0);
@@ -770,7 +774,7 @@ impl<'m> Solver<'m> {
             self.take_step();
         }
         self.previous.copy_from_slice(&self.qpos);
-        Ok(())
+        Ok(self.relaxed_steps)
     }
 
     /// Tracking errors at the current configuration (as in [`FrameDiagnostics`]).
