@@ -77,13 +77,20 @@ fn mean_pos_error_cm(r: &QualityReport) -> f64 {
     100.0 * pos.iter().sum::<f64>() / pos.len() as f64
 }
 
+fn mean_rot_error_deg(r: &QualityReport) -> f64 {
+    let tracking = r.tracking.as_ref().unwrap();
+    let rot: Vec<f64> = tracking.iter().map(|b| b.rot_rad.mean).collect();
+    rot.iter().sum::<f64>().to_degrees() / rot.len() as f64
+}
+
 fn check(take: &str, range: std::ops::Range<usize>) {
     let Some(gmr) = solve(take, range.clone(), RetargetOptions::gmr()) else { return };
     let def = solve(take, range, RetargetOptions::default()).unwrap();
     let (g, d) = (&gmr, &def);
     eprintln!(
         "{take}: penetration {:.3}/{:.3}, self-collision frames {}/{}, skate {:.4}/{:.4}, \
-         sole in band {:.3}/{:.3}, speed over {}/{}, jitter {:.2}/{:.2}, pos err {:.2}/{:.2} cm",
+         sole in band {:.3}/{:.3}, speed over {}/{}, jitter {:.2}/{:.2}, pos err {:.2}/{:.2} cm, \
+         rot err {:.2}/{:.2}°",
         g.ground_penetration.duration,
         d.ground_penetration.duration,
         g.self_collision.frames_deep,
@@ -98,6 +105,8 @@ fn check(take: &str, range: std::ops::Range<usize>) {
         mean_jitter(d),
         mean_pos_error_cm(g),
         mean_pos_error_cm(d),
+        mean_rot_error_deg(g),
+        mean_rot_error_deg(d),
     );
     // Nothing through the floor, nothing through itself, within the speed limits.
     assert_eq!(d.ground_penetration.frames, 0, "{:?}", d.ground_penetration);
@@ -113,6 +122,8 @@ fn check(take: &str, range: std::ops::Range<usize>) {
     // No extra jitter; tracking as good as GMR's to within 10 %.
     assert!(mean_jitter(d) <= mean_jitter(g), "{} > {}", mean_jitter(d), mean_jitter(g));
     assert!(mean_pos_error_cm(d) < 1.1 * mean_pos_error_cm(g));
+    let (rot_g, rot_d) = (mean_rot_error_deg(g), mean_rot_error_deg(d));
+    assert!(rot_d < 1.1 * rot_g, "rotation error {rot_d:.2}° against GMR's {rot_g:.2}°");
 }
 
 #[test]
