@@ -174,6 +174,14 @@ fn print_summary(
     if !diag.human_inferred.is_empty() {
         println!("inferred: {}", diag.human_inferred);
     }
+    if let Some(offset) = diag.pelvis_offset {
+        println!(
+            "default solve: the pelvis stands {:.1} cm off its target with the config's \
+             weights; trunk and leg weights reweighed {:.0} %",
+            100.0 * offset,
+            100.0 * diag.reweigh_share
+        );
+    }
     println!(
         "solved in {wall:.3} s wall ({:.0} frames/s overall, IK {:.0} frames/s)",
         frames as f64 / wall.max(1e-9),

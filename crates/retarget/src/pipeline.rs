@@ -69,17 +69,23 @@ pub struct PlausibleOptions {
     /// ([`smooth_trajectory`]).
     pub twicing: bool,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
-    /// [`reweigh`]). GMR balanced its leg rotation weights (5–10) against feet that follow
-    /// the human's; planted, the feet and the pelvis position decide the legs' posture and
-    /// the legs' orientations gave way (the G1's hips and knees 2–4° further from their
-    /// targets than with GMR's solve).
+    /// [`reweigh`]) where the config's targets disagree with the robot's legs. GMR balanced
+    /// its leg rotation weights (5–10) against feet that follow the human's; planted, the
+    /// feet and the pelvis position decide the legs' posture and the legs' orientations gave
+    /// way (the G1's hips and knees 2–4° further from their targets than with GMR's solve).
     pub trunk_rotation_scale: f64,
-    /// The root's position weight is at most this ([`reweigh`]). GMR weighs the G1's and
-    /// the H1's pelvis position 100 (its other configs 10–50): with the feet planted on the
-    /// floor, that holds the pelvis at the scaled human's height, which the robot's legs,
-    /// longer for that scale, reach only by bending away from the human's leg orientations
-    /// (the G1's pelvis stood 1.7 cm above its target on the LAFAN1 walk).
+    /// The root's position weight is at most this ([`reweigh`]) where the config's targets
+    /// disagree with the robot's legs. GMR weighs the G1's and the H1's pelvis position 100
+    /// (its other configs 10–50): with the feet planted on the floor, that held the G1's
+    /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
     pub root_position_weight_cap: f64,
+    /// How far (m) the robot's pelvis stands from its target, median over a few windows of
+    /// the clip solved with the config's weights ([`Prepared::pelvis_offset`]), over which
+    /// the two changes above fade in (smoothstep from the first to the second). GMR's tuned
+    /// configs on the LAFAN1 takes: G1 1.6 / 3.1 cm, T1 3.9 / 4.7, PM01 7.5 / 7.8, H1
+    /// 3.3 / 5.2, N1 0.4 / 1.4; our derived configs, every shared BVH file on the G1 and
+    /// the T1: 0.1–1.3 cm (their scales come from the robot's own limbs).
+    pub pelvis_offset_range: [f64; 2],
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
     pub repair_steps: usize,
@@ -123,6 +129,7 @@ impl Default for PlausibleOptions {
             twicing: true,
             trunk_rotation_scale: 2.0,
             root_position_weight_cap: 20.0,
+            pelvis_offset_range: [0.005, 0.015],
             repair_weight: 1000.0,
             repair_steps: 1,
             max_extra_steps: 10,
@@ -194,6 +201,11 @@ pub struct ClipDiagnostics {
     pub human_inferred: String,
     /// Wall time of the IK alone (seconds).
     pub solve_seconds: f64,
+    /// How far (m) the robot's pelvis stood above or below its target with the config's
+    /// weights ([`PlausibleOptions::pelvis_offset_range`]; default solve with planted feet),
+    /// and the share of [`reweigh`]'s changes applied (0 to 1).
+    pub pelvis_offset: Option<f64>,
+    pub reweigh_share: f64,
 }
 
 impl ClipDiagnostics {
@@ -292,6 +304,11 @@ pub(crate) struct Prepared<'a> {
     plan: Option<([Option<usize>; 2], FootPlan)>,
     fps: f64,
     height: f64,
+    /// Target slot of the human root.
+    root_target: usize,
+    /// [`ClipDiagnostics::pelvis_offset`] and [`ClipDiagnostics::reweigh_share`].
+    pelvis_offset: Option<f64>,
+    reweigh_share: f64,
 }
 
 /// Solved frames of a range.
@@ -313,7 +330,7 @@ impl<'a> Prepared<'a> {
             .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
         config.validate(model, &human.body_names)?;
         let map = TargetMap::new(config, &human.body_names, height)?;
-        let stages = mode_task_specs(config, model, &map, &options.mode);
+        let stages = task_specs(config, model, &map);
         let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
         let (nb, nf) = (human.num_bodies(), human.num_frames);
         let slots = map.bodies.len();
@@ -340,6 +357,9 @@ impl<'a> Prepared<'a> {
             plan: None,
             fps: human.fps,
             height,
+            root_target: map.root,
+            pelvis_offset: None,
+            reweigh_share: 0.0,
         };
         // The source's contact phases are written in both modes (GMR's solve ignores them);
         // the default mode plants the feet on them.
@@ -355,6 +375,9 @@ impl<'a> Prepared<'a> {
         if let SolveMode::Plausible(plausible) = &options.mode {
             if plausible.planting == Planting::On {
                 prepared.plan_feet(plausible);
+                if prepared.plan.is_some() {
+                    prepared.reweigh(plausible)?;
+                }
             }
         }
         Ok(prepared)
@@ -374,6 +397,65 @@ impl<'a> Prepared<'a> {
             &options.feet,
         );
         self.plan = Some((feet.map(|f| f.map(|f| f.body)), plan));
+    }
+
+    /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
+    /// ([`Prepared::pelvis_offset`], [`PlausibleOptions::pelvis_offset_range`]).
+    fn reweigh(&mut self, options: &PlausibleOptions) -> Result<(), Error> {
+        let Some(offset) = self.pelvis_offset()? else { return Ok(()) };
+        let [from, to] = options.pelvis_offset_range;
+        let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
+        let share = t * t * (3.0 - 2.0 * t);
+        reweigh(&mut self.stages, self.model, self.root_target, options, share);
+        (self.pelvis_offset, self.reweigh_share) = (Some(offset), share);
+        Ok(())
+    }
+
+    /// How far (m) the robot's pelvis stands from its target with the config's weights: the
+    /// norm of the median offset over [`PELVIS_WINDOWS`] windows of [`PELVIS_WINDOW`] frames
+    /// (at a quarter, half and three quarters of the clip, or the whole of a shorter clip),
+    /// each solved from its first frame as a clip is, its first frames left out. `None`
+    /// when no task tracks the root's position.
+    fn pelvis_offset(&self) -> Result<Option<f64>, Error> {
+        let root = self
+            .stages
+            .iter()
+            .flatten()
+            .find(|t| t.target == self.root_target && t.pos_weight > 0.0);
+        let Some(body) = root.map(|t| t.body) else { return Ok(None) };
+        let frames = self.num_frames();
+        let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * PELVIS_WINDOW {
+            std::iter::once(0..frames).collect()
+        } else {
+            (1..=PELVIS_WINDOWS)
+                .map(|k| {
+                    let start = frames * k / (PELVIS_WINDOWS + 1) - PELVIS_WINDOW / 2;
+                    start..start + PELVIS_WINDOW
+                })
+                .collect()
+        };
+        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
+        let mut solver = self.solver()?;
+        let mut heights = Vec::with_capacity(PELVIS_WINDOWS * PELVIS_WINDOW);
+        for window in windows {
+            for f in window.clone() {
+                self.set_frame_tasks(&mut solver, f)?;
+                let targets = self.frame_targets(f);
+                if f == window.start {
+                    solve_first_frame(self.model, &mut solver, &self.tracked, targets)?;
+                } else {
+                    solver.solve_frame(targets, dt)?;
+                }
+                if f >= window.start + PELVIS_SETTLE || window.len() <= PELVIS_SETTLE {
+                    heights.push(solver.data().xpos[body].z - targets[self.root_target].pos.z);
+                }
+            }
+        }
+        if heights.is_empty() {
+            return Ok(None);
+        }
+        let median = crate::report::percentile(&heights, 0.5);
+        Ok(Some(median.abs()))
     }
 
     fn contact_weight(&self) -> f64 {
@@ -569,6 +651,8 @@ impl<'a> Prepared<'a> {
             human_height_source: "given".to_owned(),
             human_inferred: String::new(),
             solve_seconds,
+            pelvis_offset: self.pelvis_offset,
+            reweigh_share: self.reweigh_share,
         };
         (motion, diag)
     }
@@ -787,6 +871,13 @@ fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize, twicing: bool) 
     out
 }
 
+/// Windows of a clip solved to measure how far the pelvis stands from its target
+/// ([`Prepared::pelvis_offset`]), their length in frames, and the frames at the start of each
+/// left out (the solve settles from its start pose).
+const PELVIS_WINDOWS: usize = 3;
+const PELVIS_WINDOW: usize = 30;
+const PELVIS_SETTLE: usize = 5;
+
 /// How deep (m) a repaired frame may leave a collision geom in the floor or two in each
 /// other before the first pass's pose is kept instead (the report counts from 1 cm).
 const REPAIR_SLACK: f64 = 0.002;
@@ -860,44 +951,38 @@ fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2]
     })
 }
 
-/// The tasks a solve in `mode` runs: [`task_specs`], [`reweigh`]ed in the default mode.
-pub(crate) fn mode_task_specs(
-    config: &IkConfig,
-    model: &Model,
-    map: &TargetMap,
-    mode: &SolveMode,
-) -> Vec<Vec<TaskSpec>> {
-    let mut stages = task_specs(config, model, map);
-    if let SolveMode::Plausible(p) = mode {
-        reweigh(&mut stages, model, map.root, p);
-    }
-    stages
-}
-
-/// The default solve's weights: the config's, with the rotation weight of every task whose
-/// body is not on an arm multiplied by [`PlausibleOptions::trunk_rotation_scale`], and the
-/// position weight of the root's task (the task whose target is the human root, slot
-/// `root_target`) at most [`PlausibleOptions::root_position_weight_cap`]. The arms are the
-/// subtrees that hang from the recognised chest towards each upper arm
+/// The default solve's weights where the config's targets disagree with the robot's legs:
+/// the config's, with the rotation weight of every task whose body is not on an arm
+/// multiplied by [`PlausibleOptions::trunk_rotation_scale`], and the position weight of the
+/// root's task (the task whose target is the human root, slot `root_target`) at most
+/// [`PlausibleOptions::root_position_weight_cap`]; `share` (0 to 1) of each change. The arms
+/// are the subtrees that hang from the recognised chest towards each upper arm
 /// ([`crate::RobotRoles`]); a robot the recogniser rejects keeps its rotation weights.
 ///
 /// LAFAN1, GMR's configs, default solve, mean rotation error against `--gmr`'s (its
 /// position error stays within 1.02× of `--gmr`'s on the G1): G1 walk 1.17× → 1.05×, jumps
-/// 1.24× → 1.09× (with [`PlausibleOptions::twicing`]).
+/// 1.24× → 1.09× (with [`PlausibleOptions::twicing`]). On configs whose targets agree with
+/// the robot's legs it trades position for little rotation (every share 1, our derived
+/// config, the G1 on the Bandai walk: 4.29° → 4.04°, 1.55 → 2.97 cm), hence the share.
 pub fn reweigh(
     stages: &mut [Vec<TaskSpec>],
     model: &Model,
     root_target: usize,
     options: &PlausibleOptions,
+    share: f64,
 ) {
+    if share <= 0.0 {
+        return;
+    }
     let arms = crate::RobotRoles::recognise(model).ok().and_then(|roles| arm_roots(model, &roles));
+    let trunk = 1.0 + share * (options.trunk_rotation_scale - 1.0);
     for task in stages.iter_mut().flatten() {
-        if task.target == root_target {
-            task.pos_weight = task.pos_weight.min(options.root_position_weight_cap);
+        if task.target == root_target && task.pos_weight > options.root_position_weight_cap {
+            task.pos_weight -= share * (task.pos_weight - options.root_position_weight_cap);
         }
         if let Some(arms) = &arms {
             if !arms.iter().any(|&arm| crate::feet::is_descendant(model, task.body, arm)) {
-                task.rot_weight *= options.trunk_rotation_scale;
+                task.rot_weight *= trunk;
             }
         }
     }

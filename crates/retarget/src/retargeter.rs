@@ -35,8 +35,8 @@ use crate::lie::Pose;
 use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
 use crate::pipeline::{
-    build_solver, finite_pose, mode_task_specs, solve_first_frame, ClipDiagnostics,
-    PlausibleOptions, RetargetOptions, SolveMode,
+    build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, PlausibleOptions,
+    RetargetOptions, SolveMode,
 };
 use crate::report::{QualityReport, ReportOptions};
 use crate::solver::{FrameDiagnostics, Solver};
@@ -551,7 +551,7 @@ impl Stream {
         let height = options.human_height.unwrap_or(config.human_height_assumption);
         config.validate(&model, names)?;
         let map = TargetMap::new(config, names, height)?;
-        let stages = mode_task_specs(config, &model, &map, &options.mode);
+        let stages = task_specs(config, &model, &map);
         let solver = StreamSolver::try_new(model, |m| build_solver(m, &stages, &options))?;
         let tracked = solver.borrow_dependent().tracked().to_vec();
         let slots = map.bodies.len();

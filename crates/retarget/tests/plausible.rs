@@ -138,6 +138,37 @@ fn jumps_are_planted_collision_free_and_within_the_speed_limits() {
     check("lafan1_take_via_bvhtools_test2.bvh", 0..1800);
 }
 
+/// The default solve reweighs the trunk's and legs' tasks by how far the robot's pelvis
+/// stands from its target with the config's weights: GMR's tuned G1 config holds the pelvis
+/// under where the G1's legs put it (reweighed), the config derived from the skeleton's own
+/// proportions does not (kept).
+#[test]
+fn only_targets_that_disagree_with_the_legs_are_reweighed() {
+    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let bvh = first_frames(bvh::from_path(&path).unwrap(), 900);
+    let model = g1();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let tuned = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let human = retarget::derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
+    let roles = retarget::RobotRoles::recognise(&model).unwrap();
+    let derived = retarget::derive::derive(&model, &roles, &human, "derived").unwrap();
+    let diag = |config: &IkConfig| {
+        retarget::retarget_bvh(&bvh, &model, config, &RetargetOptions::default()).unwrap().1
+    };
+    let (t, d) = (diag(&tuned), diag(&derived));
+    eprintln!(
+        "pelvis offset tuned {:?} share {:.2}, derived {:?} share {:.2}",
+        t.pelvis_offset, t.reweigh_share, d.pelvis_offset, d.reweigh_share
+    );
+    assert!(t.pelvis_offset.unwrap() > 0.01 && t.reweigh_share > 0.5, "{t:?}");
+    assert!(d.pelvis_offset.unwrap() < 0.007 && d.reweigh_share < 0.2, "{d:?}");
+    // GMR's solve is never reweighed.
+    let gmr = retarget::retarget_bvh(&bvh, &model, &tuned, &RetargetOptions::gmr()).unwrap().1;
+    assert_eq!((gmr.pelvis_offset, gmr.reweigh_share), (None, 0.0));
+}
+
 /// A shipped robot's whole LAFAN1 take with the default solve (as `retarget --bvh … --robot
 /// key` runs it): nothing deeper than 1 cm in the floor or in itself. The H1's jumps and walk
 /// and ToddlerBot's walk had frames where the one repair step after smoothing left a geom in
