@@ -69,7 +69,9 @@ pub struct PlausibleOptions {
     /// ([`smooth_trajectory`]).
     pub twicing: bool,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
-    /// [`reweigh`]) where the config's targets disagree with the robot's legs. GMR balanced
+    /// [`reweigh`]) where the config pins the pelvis at a height that disagrees with the
+    /// robot's legs (its position weight above [`PlausibleOptions::root_position_weight_cap`],
+    /// [`PlausibleOptions::pelvis_offset_range`]). GMR balanced
     /// its leg rotation weights (5–10) against feet that follow the human's; planted, the
     /// feet and the pelvis position decide the legs' posture and the legs' orientations gave
     /// way (the G1's hips and knees 2–4° further from their targets than with GMR's solve).
@@ -79,12 +81,13 @@ pub struct PlausibleOptions {
     /// (its other configs 10–50): with the feet planted on the floor, that held the G1's
     /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
     pub root_position_weight_cap: f64,
-    /// How far (m) the robot's pelvis stands from its target, median over a few windows of
-    /// the clip solved with the config's weights ([`Prepared::pelvis_offset`]), over which
-    /// the two changes above fade in (smoothstep from the first to the second). GMR's tuned
-    /// configs on the LAFAN1 takes: G1 1.6 / 3.1 cm, T1 3.9 / 4.7, PM01 7.5 / 7.8, H1
-    /// 3.3 / 5.2, N1 0.4 / 1.4; our derived configs, every shared BVH file on the G1 and
-    /// the T1: 0.1–1.3 cm (their scales come from the robot's own limbs).
+    /// How far (m) the robot's pelvis stands above or below its target, median over a few
+    /// windows of the clip solved with the config's weights ([`Prepared::pelvis_offset`]),
+    /// over which the two changes above fade in (smoothstep from the first to the second).
+    /// Measured where the root's position weight is above the cap: GMR's G1 config on the
+    /// LAFAN1 walk / jumps 1.3 / 2.8 cm, its H1 config 5.0 / 3.5; our derived configs
+    /// (pelvis weight 100 too) 0–0.5 cm on CMU, Mixamo, Rigify and the Bandai kick and run,
+    /// 0.5–1.8 cm on the Bandai walks and dance (their scales come from the robot's limbs).
     pub pelvis_offset_range: [f64; 2],
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
@@ -402,6 +405,15 @@ impl<'a> Prepared<'a> {
     /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
     /// ([`Prepared::pelvis_offset`], [`PlausibleOptions::pelvis_offset_range`]).
     fn reweigh(&mut self, options: &PlausibleOptions) -> Result<(), Error> {
+        // Only a root position weight above the cap holds the pelvis where the legs cannot
+        // follow (GMR's G1 and H1 configs, 100; its T1, PM01 and ToddlerBot configs weigh it
+        // 10, and doubling their trunk's and legs' rotation weights alone cost the PM01's
+        // jumps position, 1.07× → 1.14× `--gmr`'s).
+        let cap = options.root_position_weight_cap;
+        let root = self.root_target;
+        if !self.stages.iter().flatten().any(|t| t.target == root && t.pos_weight > cap) {
+            return Ok(());
+        }
         let Some(offset) = self.pelvis_offset()? else { return Ok(()) };
         let [from, to] = options.pelvis_offset_range;
         let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
@@ -411,11 +423,13 @@ impl<'a> Prepared<'a> {
         Ok(())
     }
 
-    /// How far (m) the robot's pelvis stands from its target with the config's weights: the
-    /// norm of the median offset over [`PELVIS_WINDOWS`] windows of [`PELVIS_WINDOW`] frames
-    /// (at a quarter, half and three quarters of the clip, or the whole of a shorter clip),
-    /// each solved from its first frame as a clip is, its first frames left out. `None`
-    /// when no task tracks the root's position.
+    /// How far (m) the robot's pelvis stands above or below its target with the config's
+    /// weights: the median height difference over [`PELVIS_WINDOWS`] windows of
+    /// [`PELVIS_WINDOW`] frames (at a quarter, half and three quarters of the clip, or the
+    /// whole of a shorter clip), each solved from its first frame as a clip is, its first
+    /// frames left out. Height only: the horizontal offsets follow the direction of travel
+    /// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). `None` when no task
+    /// tracks the root's position.
     fn pelvis_offset(&self) -> Result<Option<f64>, Error> {
         let root = self
             .stages
@@ -951,7 +965,8 @@ fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2]
     })
 }
 
-/// The default solve's weights where the config's targets disagree with the robot's legs:
+/// The default solve's weights where the config pins the pelvis at a height that disagrees
+/// with the robot's legs:
 /// the config's, with the rotation weight of every task whose body is not on an arm
 /// multiplied by [`PlausibleOptions::trunk_rotation_scale`], and the position weight of the
 /// root's task (the task whose target is the human root, slot `root_target`) at most
