@@ -66,7 +66,7 @@ pub struct PlausibleOptions {
     pub smoothing_passes: usize,
     /// Filter the trajectory by `2S − S²` instead of `S` (`S`: the passes above), Tukey's
     /// "twicing": flatter where the motion is and as strong where the jitter is
-    /// ([`smooth_trajectory`]).
+    /// (`pipeline::smooth_trajectory`).
     pub twicing: bool,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
     /// [`reweigh`]) where the config pins the pelvis at a height that disagrees with the
@@ -82,7 +82,7 @@ pub struct PlausibleOptions {
     /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
     pub root_position_weight_cap: f64,
     /// How far (m) the robot's pelvis stands above or below its target, median over a few
-    /// windows of the clip solved with the config's weights ([`Prepared::pelvis_offset`]),
+    /// windows of the clip solved with the config's weights (`Prepared::pelvis_offset`),
     /// over which the two changes above fade in (smoothstep from the first to the second).
     /// Measured where the root's position weight is above the cap: GMR's G1 config on the
     /// LAFAN1 walk / jumps 1.3 / 2.8 cm, its H1 config 5.0 / 3.5; our derived configs
