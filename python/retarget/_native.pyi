@@ -72,6 +72,10 @@ class Motion:
         """Up axis, unit and roles inferred from the source; the config used."""
     @property
     def solve_seconds(self) -> float: ...
+    @property
+    def reweighing(self) -> Tuple[Optional[float], float]:
+        """Pelvis height off its target with the config's weights (m, or None) and the
+        share of the default solve's trunk-and-leg reweighing applied."""
     def to_dict(self) -> Dict[str, np.ndarray]:
         """Every array of the ``.npz`` exactly as ``numpy.load`` gives it."""
     def save(self, path: PathLike, format: Optional[str] = None) -> None:

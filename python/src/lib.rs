@@ -467,6 +467,14 @@ impl Motion {
         self.diag.solve_seconds
     }
 
+    /// How far (m) the robot's pelvis stood above or below its target with the config's
+    /// weights (``None`` where it was not measured: GMR's solve, streams, configs that do not
+    /// pin the pelvis), and the share (0 to 1) of the default solve's reweighing applied.
+    #[getter]
+    fn reweighing(&self) -> (Option<f64>, f64) {
+        (self.diag.pelvis_offset, self.diag.reweigh_share)
+    }
+
     /// Every array of the ``.npz`` by key, exactly as ``numpy.load`` gives them (``fps`` of
     /// shape (1,), names as unicode arrays).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
