@@ -448,20 +448,14 @@ impl<'a> Prepared<'a> {
                 })
                 .collect()
         };
-        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
         let mut solver = self.solver()?;
         let mut heights = Vec::with_capacity(PELVIS_WINDOWS * PELVIS_WINDOW);
         for window in windows {
             for f in window.clone() {
-                self.set_frame_tasks(&mut solver, f)?;
-                let targets = self.frame_targets(f);
-                if f == window.start {
-                    solve_first_frame(self.model, &mut solver, &self.tracked, targets)?;
-                } else {
-                    solver.solve_frame(targets, dt)?;
-                }
+                self.first_pass_frame(&mut solver, f, f == window.start)?;
                 if f >= window.start + PELVIS_SETTLE || window.len() <= PELVIS_SETTLE {
-                    heights.push(solver.data().xpos[body].z - targets[self.root_target].pos.z);
+                    let target = &self.frame_targets(f)[self.root_target];
+                    heights.push(solver.data().xpos[body].z - target.pos.z);
                 }
             }
         }
@@ -501,8 +495,7 @@ impl<'a> Prepared<'a> {
         };
         let reach = if twicing { 2 * passes } else { passes };
         let end = (range.end + reach).min(self.num_frames());
-        let plausible = matches!(self.options.mode, SolveMode::Plausible(_));
-        let dt = if self.fps > 0.0 { 1.0 / self.fps } else { 0.0 };
+        let dt = self.frame_dt();
         let mut qpos = Vec::with_capacity((end - first) * nq);
         let mut frames = Vec::with_capacity(end - first);
         // Both passes hold every constraint. (A first pass under box bounds only is 1.4×
@@ -510,12 +503,7 @@ impl<'a> Prepared<'a> {
         // Toddy's hips, one repair step then cannot get out within the speed limits and drops
         // the self-collision rows: 1402 frames > 1 cm against 14.)
         for f in first..end {
-            self.set_frame_tasks(&mut solver, f)?;
-            frames.push(if plausible && f == first {
-                solve_first_frame(self.model, &mut solver, &self.tracked, self.frame_targets(f))?
-            } else {
-                solver.solve_frame(self.frame_targets(f), first_frame_dt(f == first, dt))?
-            });
+            frames.push(self.first_pass_frame(&mut solver, f, f == first)?);
             reject_divergence(solver.qpos(), f)?;
             qpos.extend_from_slice(solver.qpos());
         }
@@ -587,6 +575,34 @@ impl<'a> Prepared<'a> {
         qpos.truncate((range.end - first) * nq);
         frames.truncate(range.end - first);
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
+    }
+
+    /// Frame `f` of a first pass: its foot tasks set, solved from the previous frame's pose
+    /// (the `first` of a solve: from [`solve_first_frame`]'s start in the default mode, and
+    /// without speed limits).
+    fn first_pass_frame(
+        &self,
+        solver: &mut Solver<'_>,
+        f: usize,
+        first: bool,
+    ) -> Result<FrameDiagnostics, Error> {
+        self.set_frame_tasks(solver, f)?;
+        let targets = self.frame_targets(f);
+        let diagnostics = if first && matches!(self.options.mode, SolveMode::Plausible(_)) {
+            solve_first_frame(self.model, solver, &self.tracked, targets)?
+        } else {
+            solver.solve_frame(targets, first_frame_dt(first, self.frame_dt()))?
+        };
+        Ok(diagnostics)
+    }
+
+    /// Seconds between frames (0 for a clip without a rate).
+    fn frame_dt(&self) -> f64 {
+        if self.fps > 0.0 {
+            1.0 / self.fps
+        } else {
+            0.0
+        }
     }
 
     fn frame_targets(&self, f: usize) -> &[Pose] {
