@@ -137,6 +137,7 @@ fn info(robot: &str, json: Option<&std::path::Path>) -> anyhow::Result<ExitCode>
         let parent = if i == 0 { "-" } else { &model.bodies[b.parent].name };
         writeln!(out, "  {i:>3} {:<32} {parent}", b.name)?;
     }
+    self_collision_lines(&model, &mut out)?;
     writeln!(out, "\nroles (the canonical humanoid's, at qpos0):")?;
     match retarget::RobotRoles::recognise(&model) {
         Ok(roles) => out.push_str(&roles.describe(&model)),
@@ -144,6 +145,64 @@ fn info(robot: &str, json: Option<&std::path::Path>) -> anyhow::Result<ExitCode>
     }
     emit(&out)?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Configurations sampled per pair by `robot info`'s chain-contact hint, and its seed.
+const CHAIN_SAMPLES: usize = 400;
+const CHAIN_SEED: u64 = 0x5eed_c4a1;
+
+/// A chain pair touching in at least this share of its joints' ranges is listed as a hint.
+const CHAIN_HINT_SHARE: f64 = 0.1;
+
+/// `robot info`'s self-collision section: how many pairs the solve keeps apart, and the pairs
+/// on one chain whose primitives touch over much of the ranges of the joints between them
+/// ([`mjcf::Model::chain_contacts`]): a hint towards an `<exclude>` where the geometry is
+/// coarser than the parts.
+fn self_collision_lines(model: &Model, out: &mut String) -> anyhow::Result<()> {
+    let pairs = model.self_collision_pairs();
+    writeln!(
+        out,
+        "\nself-collision: {} pairs kept apart ({} adjacent in effect and {} touching at qpos0 \
+         left out)",
+        pairs.pairs.len(),
+        pairs.adjacent.len(),
+        pairs.touching_at_rest.len()
+    )?;
+    let geom = |g: usize| match model.geoms[g].name.as_str() {
+        "" => format!("geom {g}"),
+        name => name.to_owned(),
+    };
+    let hints: Vec<_> = model
+        .chain_contacts(CHAIN_SAMPLES, CHAIN_SEED)
+        .into_iter()
+        .filter(|c| c.share >= CHAIN_HINT_SHARE)
+        .collect();
+    if hints.is_empty() {
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "  pairs on one chain that touch in {:.0} % or more of the ranges of the joints between \
+         them ({CHAIN_SAMPLES} samples each); where that is geometry coarser than the parts, \
+         not a real limit, <contact><exclude body1=\"…\" body2=\"…\"/></contact> leaves the \
+         pair out:",
+        100.0 * CHAIN_HINT_SHARE
+    )?;
+    for c in hints {
+        let [a, b] = c.bodies;
+        writeln!(
+            out,
+            "    {:>5.1} %  {} / {}  (bodies {} / {}, {} joint{} between)",
+            100.0 * c.share,
+            geom(c.geoms[0]),
+            geom(c.geoms[1]),
+            model.bodies[a].name,
+            model.bodies[b].name,
+            c.joints,
+            if c.joints == 1 { "" } else { "s" }
+        )?;
+    }
+    Ok(())
 }
 
 /// The roles of `robot info --json` (see [`RobotCommand::Info`]).

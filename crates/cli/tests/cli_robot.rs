@@ -96,6 +96,30 @@ fn robot_info_prints_joints_and_bodies() {
     }
 }
 
+/// `robot info` counts the self-collision pairs and, for the T1 with its `<exclude>`s taken
+/// out, names the forearm pairs that they leave out as touching over most of their ranges.
+#[test]
+fn robot_info_hints_at_chain_pairs_that_touch_over_their_ranges() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../robots/booster_t1_29dof/booster_t1_29dof.xml");
+    let xml = std::fs::read_to_string(&path).unwrap();
+    let dir = std::env::temp_dir().join(format!("retarget-chain-hint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bare = dir.join("t1_no_excludes.xml");
+    let stripped: Vec<&str> = xml.lines().filter(|l| !l.contains("<exclude")).collect();
+    std::fs::write(&bare, stripped.join("\n")).unwrap();
+    let hinted = |p: &Path| {
+        let out = retarget(&["robot", "info", p.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = stdout(&out);
+        assert!(text.contains("self-collision: "), "{text}");
+        text.lines().any(|l| l.contains("AL4_col / AL6_col") && l.contains("2 joints between"))
+    };
+    assert!(hinted(&bare), "no hint for the T1's forearm pair without its <exclude>");
+    assert!(!hinted(&path), "a hint for a pair the shipped T1 excludes");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `robot info` on the shared G1 URDF: a free root and 29 hinges with the file's ranges and
 /// speed limits.
 #[test]

@@ -223,6 +223,79 @@ impl Model {
     }
 }
 
+/// A self-collision pair whose bodies lie on one chain (one is an ancestor of the other), and
+/// how often its primitives touch within the ranges of the joints between them
+/// ([`Model::chain_contacts`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainContact {
+    /// Geom ids, as in [`SelfCollisionPairs::pairs`].
+    pub geoms: [usize; 2],
+    /// The bodies of the two geoms, ancestor first.
+    pub bodies: [usize; 2],
+    /// Joints between them (on the bodies below the ancestor down to the descendant).
+    pub joints: usize,
+    /// Share of the sampled configurations in which the primitives touch or overlap.
+    pub share: f64,
+}
+
+impl Model {
+    /// The [`Model::self_collision_pairs`] whose bodies lie on one chain, with the share of
+    /// `samples` configurations (every other joint at `qpos0`, the joints between the two
+    /// bodies uniform in their ranges by [`Model::random_qpos`]'s rule, seeded by `seed`) in
+    /// which their primitives touch. A pair that touches over much of those ranges is either
+    /// a real limit of the mechanism (a forearm folding onto the upper arm) or primitives
+    /// coarser than the parts (a motor box reaching into the next link): the second kind
+    /// holds the retargeted motion away from poses the robot can reach, and an `<exclude>`
+    /// of the two bodies leaves it out. Sorted by share, largest first.
+    #[must_use]
+    pub fn chain_contacts(&self, samples: usize, seed: u64) -> Vec<ChainContact> {
+        use rand::SeedableRng as _;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut data = Data::new(self);
+        let ancestry = |mut b: usize, ancestor: usize| -> Option<Vec<usize>> {
+            // The bodies from `b` up to `ancestor` (exclusive), if it is one.
+            let mut path = Vec::new();
+            while b != ancestor {
+                if b == 0 {
+                    return None;
+                }
+                path.push(b);
+                b = self.bodies.get(b)?.parent;
+            }
+            Some(path)
+        };
+        let mut out = Vec::new();
+        for [g1, g2] in self.self_collision_pairs().pairs {
+            let (b1, b2) = (self.geoms[g1].body, self.geoms[g2].body);
+            let Some((bodies, path)) = ancestry(b2, b1)
+                .map(|p| ([b1, b2], p))
+                .or_else(|| ancestry(b1, b2).map(|p| ([b2, b1], p)))
+            else {
+                continue;
+            };
+            let joints: Vec<_> = self.joints.iter().filter(|j| path.contains(&j.body)).collect();
+            if joints.is_empty() || samples == 0 {
+                continue;
+            }
+            let mut touching = 0;
+            for _ in 0..samples {
+                let mut qpos = self.qpos0.clone();
+                for joint in &joints {
+                    crate::sample::random_joint(joint, &mut rng, &mut qpos);
+                }
+                self.kinematics(&qpos, &mut data);
+                if geom_distance(self, &data, g1, g2, 0.0).is_some_and(|p| p.distance <= 0.0) {
+                    touching += 1;
+                }
+            }
+            let share = touching as f64 / samples as f64;
+            out.push(ChainContact { geoms: [g1, g2], bodies, joints: joints.len(), share });
+        }
+        out.sort_by(|a, b| b.share.total_cmp(&a.share));
+        out
+    }
+}
+
 /// A primitive's convex core (the radius is kept apart), in the geom's frame.
 #[derive(Debug, Clone, Copy)]
 enum Core {

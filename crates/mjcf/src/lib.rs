@@ -47,8 +47,8 @@ mod urdf;
 use std::path::Path;
 
 pub use collision::{
-    box_manifold, geom_bounding_sphere, geom_distance, geom_lowest_point, ContactPoint, Manifold,
-    ManifoldFeature, Proximity, SelfCollisionPairs, MAX_MANIFOLD_POINTS,
+    box_manifold, geom_bounding_sphere, geom_distance, geom_lowest_point, ChainContact,
+    ContactPoint, Manifold, ManifoldFeature, Proximity, SelfCollisionPairs, MAX_MANIFOLD_POINTS,
 };
 pub use error::{Error, Location};
 pub use kinematics::Data;

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use rand::Rng;
 
-use crate::model::{JointType, Model};
+use crate::model::{Joint, JointType, Model};
 
 impl Model {
     /// A random `qpos`: free joints at a random pose (x, y in [-2, 2], z in [0, 2], uniform
@@ -17,26 +17,33 @@ impl Model {
     pub fn random_qpos<R: Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
         let mut qpos = self.qpos0.clone();
         for joint in &self.joints {
-            let a = joint.qpos_adr;
-            match joint.kind {
-                JointType::Free => {
-                    qpos[a] = rng.gen_range(-2.0..2.0);
-                    qpos[a + 1] = rng.gen_range(-2.0..2.0);
-                    qpos[a + 2] = rng.gen_range(0.0..2.0);
-                    qpos[a + 3..a + 7].copy_from_slice(&random_quat(rng));
-                }
-                JointType::Ball => qpos[a..a + 4].copy_from_slice(&random_quat(rng)),
-                JointType::Hinge | JointType::Slide => {
-                    let [lo, hi] = joint.range.unwrap_or(if joint.kind == JointType::Hinge {
-                        [-PI, PI]
-                    } else {
-                        [-1.0, 1.0]
-                    });
-                    qpos[a] = if lo < hi { rng.gen_range(lo..hi) } else { lo };
-                }
-            }
+            random_joint(joint, rng, &mut qpos);
         }
         qpos
+    }
+}
+
+/// Sets `joint`'s coordinates in `qpos` by [`Model::random_qpos`]'s rule.
+// `qpos_adr` of each joint and its width lie inside `nq` by the model's construction.
+#[allow(clippy::indexing_slicing)]
+pub(crate) fn random_joint<R: Rng + ?Sized>(joint: &Joint, rng: &mut R, qpos: &mut [f64]) {
+    let a = joint.qpos_adr;
+    match joint.kind {
+        JointType::Free => {
+            qpos[a] = rng.gen_range(-2.0..2.0);
+            qpos[a + 1] = rng.gen_range(-2.0..2.0);
+            qpos[a + 2] = rng.gen_range(0.0..2.0);
+            qpos[a + 3..a + 7].copy_from_slice(&random_quat(rng));
+        }
+        JointType::Ball => qpos[a..a + 4].copy_from_slice(&random_quat(rng)),
+        JointType::Hinge | JointType::Slide => {
+            let [lo, hi] = joint.range.unwrap_or(if joint.kind == JointType::Hinge {
+                [-PI, PI]
+            } else {
+                [-1.0, 1.0]
+            });
+            qpos[a] = if lo < hi { rng.gen_range(lo..hi) } else { lo };
+        }
     }
 }
 

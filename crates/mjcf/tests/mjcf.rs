@@ -473,3 +473,43 @@ fn same_kinematics(ours: &Model, reference: &Model) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// `Model::chain_contacts` finds the pairs our models leave out with `<exclude>` (primitives
+/// coarser than the parts, found on the LAFAN1 takes): with the excludes removed from
+/// ToddlerBot's and the T1's models, each excluded pair on one chain touches over most of the
+/// ranges of the joints between its bodies; with them, none of those pairs is there.
+#[test]
+fn chain_contacts_find_the_pairs_our_models_exclude() {
+    let robots_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots");
+    for (key, excluded, least) in [
+        ("stanford_toddy", [("left_calf_link", "ank_roll_link"), ("torso", "waist_link")], 0.5),
+        ("booster_t1_29dof", [("AL4", "AL6"), ("AR4", "AR6")], 0.5),
+    ] {
+        let path = robots_dir.join(format!("{key}/{key}.xml"));
+        let xml = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
+        let stripped: String =
+            xml.lines().filter(|l| !l.contains("<exclude")).collect::<Vec<_>>().join("\n");
+        assert_ne!(stripped.len(), xml.len(), "{key}: no <exclude> to strip");
+        let names = |m: &Model, c: &mjcf::ChainContact| {
+            (m.bodies[c.bodies[0]].name.clone(), m.bodies[c.bodies[1]].name.clone())
+        };
+        let bare = Model::from_xml_str(&stripped, path.parent()).unwrap_or_else(|e| panic!("{e}"));
+        let found = bare.chain_contacts(200, 7);
+        for (a, b) in excluded {
+            let share = found
+                .iter()
+                .filter(|c| names(&bare, c) == (a.to_owned(), b.to_owned()))
+                .map(|c| c.share)
+                .fold(0.0, f64::max);
+            assert!(share >= least, "{key}: {a} / {b} touch in {share} of their ranges");
+        }
+        let shipped = Model::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        for c in shipped.chain_contacts(200, 7) {
+            let pair = names(&shipped, &c);
+            assert!(
+                !excluded.iter().any(|(a, b)| pair == ((*a).to_owned(), (*b).to_owned())),
+                "{key}: excluded pair {pair:?} still checked"
+            );
+        }
+    }
+}
