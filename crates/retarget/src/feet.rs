@@ -637,21 +637,23 @@ fn keep_feet_apart(
         let yaw = (yl.sin() + yr.sin()).atan2(yl.cos() + yr.cos());
         let lateral = Vector3::new(-yaw.sin(), yaw.cos(), 0.0);
         let forward = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
-        // How far a flat sole reaches from its body origin along `axis`.
-        let reach = |foot: &RobotFoot, axis: Vector3<f64>| {
-            let flat = foot.flat(yaw);
+        // How far a flat sole turned to its own yaw reaches from its body origin along `axis`
+        // (a foot turned across the other reaches further sideways than along the mean
+        // heading: ToddlerBot's 12 cm feet, on the LAFAN1 walk's turns).
+        let reach = |foot: &RobotFoot, foot_yaw: f64, axis: Vector3<f64>| {
+            let flat = foot.flat(foot_yaw);
             foot.corners.iter().map(|c| (flat * c).dot(&axis)).fold(0.0, f64::max)
         };
         let apart = (l.pos - r.pos).dot(&lateral);
-        let short = reach(left, -lateral) + reach(right, lateral) + gap - apart;
+        let short = reach(left, yl, -lateral) + reach(right, yr, lateral) + gap - apart;
         if short <= 0.0 {
             continue;
         }
         let ahead = (l.pos - r.pos).dot(&forward);
         let clear = if ahead >= 0.0 {
-            ahead - reach(left, -forward) - reach(right, forward)
+            ahead - reach(left, yl, -forward) - reach(right, yr, forward)
         } else {
-            -ahead - reach(left, forward) - reach(right, -forward)
+            -ahead - reach(left, yl, forward) - reach(right, yr, -forward)
         };
         let alongside =
             smoothstep(((gap + ALONGSIDE_FADE - clear) / ALONGSIDE_FADE).clamp(0.0, 1.0));
@@ -1148,6 +1150,30 @@ mod tests {
         // Crossed over by 20 cm: narrowed by at most MAX_WIDENING, not uncrossed.
         let (d, _) = apart(0.0, -0.1, 0.1);
         assert!((d.y - (-0.2 + MAX_WIDENING)).abs() < 1e-12, "{d}");
+    }
+
+    /// A foot turned across the other (a turn on the spot) reaches sideways by its own
+    /// footprint, not by the footprint it would have facing the mean heading: the left foot
+    /// turned 90° to the left (yaw ±45° about the mean, 20 × 10 cm soles) is moved until the
+    /// two turned footprints are `gap` apart across the mean heading.
+    #[test]
+    fn a_foot_turned_across_the_other_is_kept_apart_by_its_own_footprint() {
+        let (left, mut right) = (box_foot(), box_foot());
+        right.slot = 1;
+        let turned = |yaw: f64, y: f64| {
+            let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
+            let q = [q.w, q.i, q.j, q.k];
+            Pose { quat: q, pos: Vector3::new(0.0, y, 0.0) }
+        };
+        let quarter = std::f64::consts::FRAC_PI_4;
+        let mut targets = vec![turned(quarter, 0.08), turned(-quarter, -0.08)];
+        keep_feet_apart(&left, &right, &mut targets, 2, 0.03);
+        // Each turned sole reaches (0.1 + 0.05) cos 45° = 10.6 cm across the mean heading
+        // (+x): 21.2 cm + the 3 cm gap between the origins.
+        let need = 2.0 * 0.15 * quarter.cos() + 0.03;
+        let d = targets[0].pos - targets[1].pos;
+        assert!((d.y - need).abs() < 1e-12, "{d} against {need}");
+        assert!(d.x.abs() < 1e-12, "{d}");
     }
 
     #[test]
