@@ -614,9 +614,10 @@ const ALONGSIDE_FADE: f64 = 0.05;
 const MAX_WIDENING: f64 = 0.1;
 
 /// Moves the two foot targets of every frame apart sideways (perpendicular to their mean
-/// heading, half each) until the inner edges of their flat soles are `gap` apart, while the
-/// soles are alongside each other: the push fades out over [`ALONGSIDE_FADE`] once one is
-/// `gap` ahead of the other, and is at most [`MAX_WIDENING`]. The scaled human's feet can pass
+/// heading, half each) until the inner edges of their flat soles, each turned to its own yaw,
+/// are `gap` apart, while the soles are alongside each other: the push fades out over
+/// [`ALONGSIDE_FADE`] once one is `gap` ahead of the other, and is at most [`MAX_WIDENING`].
+/// The scaled human's feet can pass
 /// closer than the robot's feet fit (ToddlerBot: 4.9 cm apart, median, against soles 4.2 cm
 /// wide); the self-collision rows then stop a foot short of its anchor, and it catches up
 /// later at a skate.
