@@ -174,20 +174,30 @@ fn only_targets_that_disagree_with_the_legs_are_reweighed() {
 /// and ToddlerBot's walk had frames where the one repair step after smoothing left a geom in
 /// the floor (1.6 / 1.2 cm) or two in each other (10 and 30 frames on the H1) until such
 /// frames kept the first pass's pose.
-fn nothing_in_the_floor_or_in_itself(key: &str, take: &str) {
-    let Some(path) = shared::shared_file(&format!("data/bvh/{take}")) else { return };
+fn nothing_in_the_floor_or_in_itself(key: &str, take: &str) -> Option<QualityReport> {
+    let path = shared::shared_file(&format!("data/bvh/{take}"))?;
     let retargeter = retarget::Retargeter::new(key).unwrap();
     let (motion, _) = retargeter.retarget_bvh_file(&path).unwrap();
     let r = report(&motion, retargeter.model(), &ReportOptions::default()).unwrap();
     assert_eq!(r.ground_penetration.frames, 0, "{key} {take}: {:?}", r.ground_penetration);
     assert_eq!(r.self_collision.frames_deep, 0, "{key} {take}: {:?}", r.self_collision);
+    Some(r)
 }
 
 #[test]
 fn the_repair_pass_leaves_nothing_in_the_floor_or_in_itself() {
     nothing_in_the_floor_or_in_itself("unitree_h1", "lafan1_take_via_bvhtools_test2.bvh");
     nothing_in_the_floor_or_in_itself("unitree_h1", "lafan1_take_via_bvhtools_test.bvh");
-    nothing_in_the_floor_or_in_itself("stanford_toddy", "lafan1_take_via_bvhtools_test.bvh");
+    let toddy =
+        nothing_in_the_floor_or_in_itself("stanford_toddy", "lafan1_take_via_bvhtools_test.bvh");
+    // ToddlerBot's 12 cm feet cross at up to 90° in the walk's turns: kept apart by the
+    // footprints they would have facing their mean heading, the swing foot stopped at the
+    // planted one and the planted one was dragged (58 skating frames, 0.81 %); measured by
+    // each sole's own yaw, 1.
+    if let Some(r) = toddy {
+        let skating = r.skating.as_ref().unwrap();
+        assert!(skating.duration < 0.001, "ToddlerBot walk: {skating:?}");
+    }
 }
 
 /// The default solve's first frame is its first pass's (the smoothing keeps end frames, and
