@@ -168,10 +168,6 @@ fn self_collision_lines(model: &Model, out: &mut String) -> anyhow::Result<()> {
         pairs.adjacent.len(),
         pairs.touching_at_rest.len()
     )?;
-    let geom = |g: usize| match model.geoms[g].name.as_str() {
-        "" => format!("geom {g}"),
-        name => name.to_owned(),
-    };
     let hints: Vec<_> = model
         .chain_contacts(CHAIN_SAMPLES, CHAIN_SEED)
         .into_iter()
@@ -194,8 +190,8 @@ fn self_collision_lines(model: &Model, out: &mut String) -> anyhow::Result<()> {
             out,
             "    {:>5.1} %  {} / {}  (bodies {} / {}, {} joint{} between)",
             100.0 * c.share,
-            geom(c.geoms[0]),
-            geom(c.geoms[1]),
+            model.geom_label(c.geoms[0]),
+            model.geom_label(c.geoms[1]),
             model.bodies[a].name,
             model.bodies[b].name,
             c.joints,

@@ -241,6 +241,15 @@ impl Model {
         self.sites.iter().position(|s| !s.name.is_empty() && s.name == name)
     }
 
+    /// Geom `g` for messages: its name, or `geom {g}` when it has none.
+    #[must_use]
+    pub fn geom_label(&self, g: usize) -> String {
+        match self.geoms.get(g).map(|geom| geom.name.as_str()) {
+            Some("") | None => format!("geom {g}"),
+            Some(name) => name.to_owned(),
+        }
+    }
+
     /// Number of bodies including the world.
     #[must_use]
     pub fn nbody(&self) -> usize {

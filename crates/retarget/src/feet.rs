@@ -617,10 +617,9 @@ const MAX_WIDENING: f64 = 0.1;
 /// heading, half each) until the inner edges of their flat soles, each turned to its own yaw,
 /// are `gap` apart, while the soles are alongside each other: the push fades out over
 /// [`ALONGSIDE_FADE`] once one is `gap` ahead of the other, and is at most [`MAX_WIDENING`].
-/// The scaled human's feet can pass
-/// closer than the robot's feet fit (ToddlerBot: 4.9 cm apart, median, against soles 4.2 cm
-/// wide); the self-collision rows then stop a foot short of its anchor, and it catches up
-/// later at a skate.
+/// The scaled human's feet can pass closer than the robot's feet fit (ToddlerBot: 4.9 cm
+/// apart, median, against soles 4.2 cm wide); the self-collision rows then stop a foot short
+/// of its anchor, and it catches up later at a skate.
 fn keep_feet_apart(
     left: &RobotFoot,
     right: &RobotFoot,

@@ -403,13 +403,6 @@ pub fn report(
     })
 }
 
-fn geom_label(model: &mjcf::Model, g: usize) -> String {
-    match model.geoms[g].name.as_str() {
-        "" => format!("geom {g}"),
-        name => name.to_owned(),
-    }
-}
-
 /// Ground penetration of every collision geom and self-collision, in one pass of FK.
 fn collisions(
     motion: &RobotMotion,
@@ -466,8 +459,8 @@ fn collisions(
         own.frames_deep += usize::from(deepest.is_some_and(|d| d > opts.self_collision_depth));
     }
     ground.duration = ratio(ground.frames, motion.num_frames());
-    ground.worst_geom = worst_geom.map(|g| geom_label(model, g));
-    own.worst_pair = worst_pair.map(|[a, b]| [geom_label(model, a), geom_label(model, b)]);
+    ground.worst_geom = worst_geom.map(|g| model.geom_label(g));
+    own.worst_pair = worst_pair.map(|[a, b]| [model.geom_label(a), model.geom_label(b)]);
     (ground, own)
 }
 

@@ -197,7 +197,7 @@ impl RobotRoles {
             let _ = writeln!(out, "{:<16} {:<28} {point:>24}  {}", role.name(), r.name, r.rule);
         }
         for (side, sole) in ["left", "right"].iter().zip(&self.soles) {
-            let geoms: Vec<String> = sole.geoms.iter().map(|&g| geom_name(model, g)).collect();
+            let geoms: Vec<String> = sole.geoms.iter().map(|&g| model.geom_label(g)).collect();
             let what = if geoms.is_empty() {
                 "no collision geoms: the lowest body origin".to_owned()
             } else {
@@ -218,13 +218,6 @@ fn body_name(model: &Model, b: usize) -> String {
     match model.bodies.get(b).map(|b| b.name.as_str()) {
         Some("") | None => format!("body {b}"),
         Some(name) => name.to_owned(),
-    }
-}
-
-fn geom_name(model: &Model, g: usize) -> String {
-    match model.geoms[g].name.as_str() {
-        "" => format!("geom {g}"),
-        name => name.to_owned(),
     }
 }
 
