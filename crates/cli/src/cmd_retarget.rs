@@ -182,6 +182,12 @@ fn print_summary(
             100.0 * diag.reweigh_share
         );
     }
+    if let (Some(leg), true) = (diag.leg_length, diag.smoothing_passes > 0) {
+        println!(
+            "default solve: legs {:.2} m long, trajectory smoothed over {} passes at 30 frames/s",
+            leg, diag.smoothing_passes
+        );
+    }
     println!(
         "solved in {wall:.3} s wall ({:.0} frames/s overall, IK {:.0} frames/s)",
         frames as f64 / wall.max(1e-9),

@@ -423,6 +423,37 @@ pub(crate) fn is_descendant(model: &Model, mut body: usize, ancestor: usize) -> 
     }
 }
 
+/// The robot's standing leg length (m): at `qpos0`, the height of the leg's top joint (the
+/// first joint on the way down from the body both feet hang from) above its sole's lowest
+/// point, the longer leg of the two. `None` without both feet, or where one foot hangs from
+/// the other. The G1's are 0.69 m, the T1's 0.56, the H1's 0.87, ToddlerBot's 0.28.
+#[must_use]
+pub fn leg_length(model: &Model, feet: &[Option<RobotFoot>; 2]) -> Option<f64> {
+    let [Some(a), Some(b)] = feet else { return None };
+    let mut data = Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
+    // A body and its ancestors, the body first.
+    let path = |mut body: usize| {
+        let mut path = vec![body];
+        while body != 0 {
+            body = model.bodies[body].parent;
+            path.push(body);
+        }
+        path
+    };
+    let (up_a, up_b) = (path(a.body), path(b.body));
+    let common = *up_a.iter().find(|x| up_b.contains(x))?;
+    let leg = |foot: &RobotFoot, up: &[usize]| -> Option<f64> {
+        let below = &up[..up.iter().position(|&x| x == common)?];
+        // The topmost joint of the leg: the last of the bodies below `common` that has one.
+        let hip = below.iter().rev().find(|&&body| model.bodies[body].jnt_num > 0)?;
+        let hip = data.xanchor[model.bodies[*hip].jnt_adr].z;
+        let sole = data.xpos[foot.body].z + foot.sole_offset(&foot.rest);
+        Some(hip - sole)
+    };
+    Some(leg(a, &up_a)?.max(leg(b, &up_b)?))
+}
+
 fn pose_of(pos: &Vector3<f64>, mat: &Matrix3<f64>) -> Isometry3<f64> {
     let rot = UnitQuaternion::from_matrix(mat);
     Isometry3::from_parts(Translation3::from(*pos), rot)

@@ -68,6 +68,19 @@ pub struct PlausibleOptions {
     /// "twicing": flatter where the motion is and as strong where the jitter is
     /// (`pipeline::smooth_trajectory`).
     pub twicing: bool,
+    /// Robots whose legs ([`crate::feet::leg_length`]) are shorter than this (m) are
+    /// filtered over more passes: `smoothing_passes × (smoothing_leg / leg)²`, rounded, at
+    /// most [`MAX_SMOOTHING_SCALE`] times as many. The contact handling moves a foot by
+    /// centimetres within a frame or two (the swing clearance, the planted hold, the soles
+    /// kept apart), the same on every robot, and the shorter the leg, the larger the angles
+    /// that move it: lifting ToddlerBot's swing foot (legs of 0.28 m) clear of the floor in
+    /// one frame hiked its hip by 13° (its waist rolled 17–19° where GMR's solve rolls it
+    /// 4–5°), and its LAFAN1 walk's jitter was 9.6 rad/s² against `--gmr`'s 7.6 with two
+    /// passes. A step of angle `d / leg` filtered over a kernel of `σ` frames accelerates
+    /// the joint by `∫|q̈| ∝ d / (leg · σ)`: `σ ∝ 1 / leg` holds it, and the kernel's variance
+    /// is proportional to the passes. 0.55 m is just under the T1's legs (0.56 m), the
+    /// shortest the filter was tuned on; the G1 (0.69 m), N1, PM01 and H1 keep two passes.
+    pub smoothing_leg: f64,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
     /// [`reweigh`]) where the config pins the pelvis at a height that disagrees with the
     /// robot's legs (its position weight above [`PlausibleOptions::root_position_weight_cap`],
@@ -130,6 +143,7 @@ impl Default for PlausibleOptions {
             self_collision: SelfCollisionMode::On,
             smoothing_passes: 2,
             twicing: true,
+            smoothing_leg: 0.55,
             trunk_rotation_scale: 2.0,
             root_position_weight_cap: 20.0,
             pelvis_offset_range: [0.005, 0.015],
@@ -209,6 +223,10 @@ pub struct ClipDiagnostics {
     /// and the share of [`reweigh`]'s changes applied (0 to 1).
     pub pelvis_offset: Option<f64>,
     pub reweigh_share: f64,
+    /// The robot's standing leg length (m, [`crate::feet::leg_length`]) and the smoothing
+    /// passes at 30 frames/s it gave ([`PlausibleOptions::smoothing_leg`]; default solve).
+    pub leg_length: Option<f64>,
+    pub smoothing_passes: usize,
 }
 
 impl ClipDiagnostics {
@@ -312,6 +330,10 @@ pub(crate) struct Prepared<'a> {
     /// [`ClipDiagnostics::pelvis_offset`] and [`ClipDiagnostics::reweigh_share`].
     pelvis_offset: Option<f64>,
     reweigh_share: f64,
+    /// The robot's standing leg length and the smoothing passes at 30 frames/s it gives
+    /// ([`PlausibleOptions::smoothing_leg`]; 0 in GMR's mode).
+    leg_length: Option<f64>,
+    smoothing_passes: usize,
 }
 
 /// Solved frames of a range.
@@ -363,7 +385,15 @@ impl<'a> Prepared<'a> {
             root_target: map.root,
             pelvis_offset: None,
             reweigh_share: 0.0,
+            leg_length: None,
+            smoothing_passes: 0,
         };
+        if let SolveMode::Plausible(p) = &options.mode {
+            let feet = robot_feet(model, &prepared.stages);
+            prepared.leg_length = crate::feet::leg_length(model, &feet);
+            prepared.smoothing_passes =
+                smoothing_passes_for_leg(p.smoothing_passes, p.smoothing_leg, prepared.leg_length);
+        }
         // The source's contact phases are written in both modes (GMR's solve ignores them);
         // the default mode plants the feet on them.
         let contact = match &options.mode {
@@ -489,7 +519,7 @@ impl<'a> Prepared<'a> {
         // filtered as in one pass.
         let (passes, twicing) = match &self.options.mode {
             SolveMode::Plausible(p) => {
-                (smoothing_passes_at(p.smoothing_passes, self.fps), p.twicing)
+                (smoothing_passes_at(self.smoothing_passes, self.fps), p.twicing)
             }
             SolveMode::Gmr => (0, false),
         };
@@ -683,6 +713,8 @@ impl<'a> Prepared<'a> {
             solve_seconds,
             pelvis_offset: self.pelvis_offset,
             reweigh_share: self.reweigh_share,
+            leg_length: self.leg_length,
+            smoothing_passes: self.smoothing_passes,
         };
         (motion, diag)
     }
@@ -821,6 +853,20 @@ pub(crate) fn start_pose(
 }
 
 /// Passes of the `[1, 2, 1] / 4` filter at `fps` that smooth as much, in seconds, as
+/// At most this many times [`PlausibleOptions::smoothing_passes`] for short legs
+/// ([`PlausibleOptions::smoothing_leg`]): legs of 0.19 m and longer are filtered as asked.
+pub const MAX_SMOOTHING_SCALE: f64 = 8.0;
+
+/// The smoothing passes at 30 frames/s for a robot whose legs are `leg` m long
+/// ([`PlausibleOptions::smoothing_leg`]): `passes`, times `(reference / leg)²` for legs
+/// shorter than `reference`.
+#[must_use]
+pub fn smoothing_passes_for_leg(passes: usize, reference: f64, leg: Option<f64>) -> usize {
+    let Some(leg) = leg.filter(|l| l.is_finite() && *l > 0.0) else { return passes };
+    let scale = (reference / leg).powi(2).clamp(1.0, MAX_SMOOTHING_SCALE);
+    (passes as f64 * scale).round() as usize
+}
+
 /// `passes_at_30` passes at 30 frames/s: `n` passes are a kernel of variance `n / 2` frames²,
 /// so the count scales with `(fps / 30)²` (at least one when any is asked for). At 120 fps one
 /// pass per frame left the CMU walk's jitter at 69 rad/s² against GMR's 50; 16 passes: 32.
@@ -1077,7 +1123,19 @@ pub(crate) fn finite_pose(p: &Pose) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::{diverged, smoothing_passes_at};
+    use super::{diverged, smoothing_passes_at, smoothing_passes_for_leg};
+
+    #[test]
+    fn short_legs_are_smoothed_over_more_passes() {
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.69)), 2, "the G1's legs");
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.55)), 2);
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.28)), 8, "ToddlerBot's legs");
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.05)), 16, "bounded");
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, None), 2, "no feet found");
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.0)), 2);
+        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(f64::NAN)), 2);
+        assert_eq!(smoothing_passes_for_leg(0, 0.55, Some(0.28)), 0, "none asked for");
+    }
 
     #[test]
     fn the_smoothing_spans_the_same_time_at_any_frame_rate() {
