@@ -60,9 +60,39 @@ pub fn retarget_motion_chunked(
     let seconds = started.elapsed().as_secs_f64();
     let mut qpos = Vec::with_capacity(n * model.nq);
     let mut frames = Vec::with_capacity(n);
-    for part in parts {
+    for mut part in parts {
+        if let Some(last) = qpos.len().checked_sub(model.nq).and_then(|at| qpos.get(at..)) {
+            continue_quaternions(model, last, &mut part.qpos);
+        }
         qpos.extend(part.qpos);
         frames.extend(part.frames);
     }
     Ok(prepared.finish(qpos, frames, seconds))
+}
+
+/// Negates a chunk's quaternions (free and ball joints; `qpos`: its frames) where its first
+/// frame's is on the other side of the double cover from the frame before the chunk (`last`),
+/// so that the clip's quaternions stay continuous across the seam as they do in the serial
+/// solve. Each chunk starts from `qpos0` and may settle on either sign: the LAFAN1 walk in
+/// chunks of 600 frames had the root's quaternion flip sign at 5 of its 11 seams.
+fn continue_quaternions(model: &Model, last: &[f64], qpos: &mut [f64]) {
+    let nq = model.nq.max(1);
+    for joint in &model.joints {
+        let at = match joint.kind {
+            mjcf::JointType::Free => joint.qpos_adr + 3,
+            mjcf::JointType::Ball => joint.qpos_adr,
+            mjcf::JointType::Hinge | mjcf::JointType::Slide => continue,
+        };
+        let (Some(before), Some(first)) = (last.get(at..at + 4), qpos.get(at..at + 4)) else {
+            continue;
+        };
+        if before.iter().zip(first).map(|(a, b)| a * b).sum::<f64>() >= 0.0 {
+            continue;
+        }
+        for frame in qpos.chunks_mut(nq) {
+            if let Some(q) = frame.get_mut(at..at + 4) {
+                q.iter_mut().for_each(|v| *v = -*v);
+            }
+        }
+    }
 }
