@@ -509,8 +509,12 @@ pub fn plan(
             .map(|t| foot.shin.map(|(slot, rel)| quat(&targets[t * slots + slot]) * rel))
             .collect();
         // The config's shin and foot offsets need not agree about yaw (Toddy's left calf and
-        // toe targets disagree by 180°): turn the shin's by their mean difference over the
-        // clip, so the shin only steadies the foot's yaw and never outvotes it.
+        // toe targets disagree by 177°, with GMR's config and with ours): turn the shin's by
+        // the half turn of their mean difference over the clip, if any
+        // (`convention_turn`), so that a frame convention never outvotes the foot, while the
+        // human's toe-out stays and the planted yaw shares it between the foot and the leg
+        // above, as GMR's solve does. (Turned by the whole difference, the planted yaw was
+        // the foot's, and a robot without an ankle yaw turned the whole leg to it.)
         let (mut s, mut c) = (0.0, 0.0);
         for (t, q) in shin.iter().enumerate() {
             if let Some(q) = q {
@@ -518,7 +522,8 @@ pub fn plan(
                 (s, c) = (s + d.sin(), c + d.cos());
             }
         }
-        let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -s.atan2(c));
+        let turn =
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -convention_turn(s.atan2(c)));
         for q in shin.iter_mut().flatten() {
             *q = turn * *q;
         }
@@ -614,6 +619,25 @@ pub fn plan(
         }
     }
     FootPlan { shift, weight, contact }
+}
+
+/// The part of a mean yaw difference (rad) between a foot's target and the foot its shin's
+/// target implies that comes from the config's frames, not from the human: a half turn
+/// where the two face apart (ToddlerBot's left calf and toe, 177° with GMR's config and with
+/// ours), none otherwise. A human foot turns out from its shin by a few degrees (the LAFAN1
+/// walk 3–4°, CMU 131_01 6–9°, the Bandai walk's right foot 18°, its kick 20–28°; the first
+/// 15 s of the Bandai dance 46°, where its left foot turns on the floor), and that is
+/// kept: removing it planted the foot at its own yaw, which a leg without an ankle yaw can
+/// only follow by turning the hip, knee and foot together (the G1 on the Bandai walk:
+/// rotation error 4.13° against `--gmr`'s 3.35°; 3.45° with the toe-out kept). (Rounding to
+/// the nearest quarter turn instead turned that dance's left shin by 90°: the leg's rotation
+/// error went from 0.75 to 1.07 rad.)
+fn convention_turn(mean: f64) -> f64 {
+    if mean.abs() > std::f64::consts::FRAC_PI_2 {
+        std::f64::consts::PI.copysign(mean)
+    } else {
+        0.0
+    }
 }
 
 /// How far (rad) `yaws` turn: the largest minus the smallest of their differences from
@@ -1205,6 +1229,16 @@ mod tests {
         let d = targets[0].pos - targets[1].pos;
         assert!((d.y - need).abs() < 1e-12, "{d} against {need}");
         assert!(d.x.abs() < 1e-12, "{d}");
+    }
+
+    #[test]
+    fn only_a_frame_convention_is_turned_away() {
+        let deg = f64::to_radians;
+        assert!((convention_turn(deg(177.0)) - deg(180.0)).abs() < 1e-12, "Toddy's left calf");
+        assert!((convention_turn(deg(-170.0)) + deg(180.0)).abs() < 1e-12);
+        for toe_out in [3.7, -3.0, 18.3, -46.3, 60.0] {
+            assert_eq!(convention_turn(deg(toe_out)), 0.0, "{toe_out}° is the human's");
+        }
     }
 
     #[test]

@@ -221,10 +221,12 @@ fn assert_sane(what: &str, c: &Checks, walk: bool) {
     assert!(c.facing >= 0.9, "{what}: facing the human's way in {:.0} %", c.facing * 100.0);
     assert!(c.feet > 0.6, "{what}: feet correlation {:.2}", c.feet);
     assert_eq!(c.violations, 0, "{what}: joint-limit violations");
-    // Targets the legs can follow (the Bandai dance, at most 0.75 rad, is the hardest). The
-    // Bandai run's reference frame has the left toe pointing down, and the rest of its
-    // direction turned that foot 100° and the leg with it: 1.3 rad.
-    assert!(c.leg_rotation < 1.0, "{what}: leg rotation error {:.2} rad", c.leg_rotation);
+    // Targets the legs can follow (the MocapBank take, kneeling, at most 0.55 rad, is the
+    // hardest). The Bandai run's reference frame has the left toe pointing down, and the rest
+    // of its direction turned that foot 100° and the leg with it: 1.3 rad. Until the planted
+    // foot's yaw kept the human's toe-out (`feet::convention_turn`), the Bandai dance's legs
+    // were 0.75 rad off (0.39 since), its kick's 0.49 (0.32), Rigify's 0.35 (0.18).
+    assert!(c.leg_rotation < 0.65, "{what}: leg rotation error {:.2} rad", c.leg_rotation);
     if walk {
         let (robot, human) = c.alternations;
         assert!(human >= 2, "{what}: the human's feet alternate {human} times");
