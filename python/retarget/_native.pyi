@@ -76,6 +76,10 @@ class Motion:
     def reweighing(self) -> Tuple[Optional[float], float]:
         """Pelvis height off its target with the config's weights (m, or None) and the
         share of the default solve's trunk-and-leg reweighing applied."""
+    @property
+    def smoothing(self) -> Tuple[Optional[float], int]:
+        """The robot's standing leg length (m, or None) and the default solve's smoothing
+        passes at 30 frames/s (more for legs under 0.55 m; 0 for GMR's solve)."""
     def to_dict(self) -> Dict[str, np.ndarray]:
         """Every array of the ``.npz`` exactly as ``numpy.load`` gives it."""
     def save(self, path: PathLike, format: Optional[str] = None) -> None:

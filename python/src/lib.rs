@@ -475,6 +475,14 @@ impl Motion {
         (self.diag.pelvis_offset, self.diag.reweigh_share)
     }
 
+    /// The robot's standing leg length (m, ``None`` without two feet) and the passes of the
+    /// default solve's smoothing filter at 30 frames/s it gave (legs under 0.55 m get more;
+    /// 0 for GMR's solve and streams).
+    #[getter]
+    fn smoothing(&self) -> (Option<f64>, usize) {
+        (self.diag.leg_length, self.diag.smoothing_passes)
+    }
+
     /// Every array of the ``.npz`` by key, exactly as ``numpy.load`` gives them (``fps`` of
     /// shape (1,), names as unicode arrays).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
