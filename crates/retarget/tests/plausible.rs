@@ -200,6 +200,18 @@ fn the_repair_pass_leaves_nothing_in_the_floor_or_in_itself() {
     }
 }
 
+/// The file at `path` retargeted onto the shipped robot `key` in `mode` (as the main command
+/// does it), its report and diagnostics.
+fn shipped_file(
+    key: &str,
+    path: &std::path::Path,
+    mode: retarget::SolveMode,
+) -> (QualityReport, retarget::ClipDiagnostics) {
+    let r = retarget::Retargeter::new(key).unwrap().with_mode(mode);
+    let (motion, diag) = r.retarget_bvh_file(path).unwrap();
+    (report(&motion, r.model(), &ReportOptions::default()).unwrap(), diag)
+}
+
 /// ToddlerBot's legs (0.28 m) are smoothed over 8 passes, not 2
 /// ([`retarget::PlausibleOptions::smoothing_leg`]): with 2, lifting its swing foot clear of
 /// the floor hiked its hip, and its LAFAN1 walk's jitter was 9.6 against GMR's 7.6 rad/s².
@@ -208,11 +220,7 @@ fn a_short_legged_robot_is_no_more_jittery_than_gmr() {
     let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
         return;
     };
-    let solve = |mode: retarget::SolveMode| {
-        let r = retarget::Retargeter::new("stanford_toddy").unwrap().with_mode(mode);
-        let (motion, diag) = r.retarget_bvh_file(&path).unwrap();
-        (report(&motion, r.model(), &ReportOptions::default()).unwrap(), diag)
-    };
+    let solve = |mode| shipped_file("stanford_toddy", &path, mode);
     let (default, diag) = solve(retarget::SolveMode::default());
     let leg = diag.leg_length.unwrap();
     assert!((leg - 0.282).abs() < 0.005, "{leg}");
@@ -235,11 +243,7 @@ fn a_foot_turned_out_from_its_shin_is_planted_between_the_two() {
     let Some(path) = shared::shared_file("data/bvh/bandai_dataset-1_walk_normal_001.bvh") else {
         return;
     };
-    let rotation = |mode: retarget::SolveMode| {
-        let r = retarget::Retargeter::new("unitree_g1").unwrap().with_mode(mode);
-        let (motion, _) = r.retarget_bvh_file(&path).unwrap();
-        mean_rot_error_deg(&report(&motion, r.model(), &ReportOptions::default()).unwrap())
-    };
+    let rotation = |mode| mean_rot_error_deg(&shipped_file("unitree_g1", &path, mode).0);
     let (d, g) = (rotation(retarget::SolveMode::default()), rotation(retarget::SolveMode::Gmr));
     assert!(d < 1.1 * g, "rotation error {d:.2}° against GMR's {g:.2}°");
 }
