@@ -1232,6 +1232,41 @@ mod tests {
     }
 
     #[test]
+    fn a_leg_runs_from_its_top_joint_to_its_sole() {
+        // A pelvis at 0.5 m; each leg's hip joint 5 cm below it, a knee, a foot whose box sole
+        // (2 cm thick) rests on the floor: legs of 0.45 m. The left foot hangs 1 cm higher.
+        let leg = |side: &str, y: f64, lift: f64| {
+            format!(
+                r#"<body name="{side}_thigh" pos="0 {y} -0.05"><joint name="{side}_hip" axis="0 1 0"/>
+                     <body name="{side}_shin" pos="0 0 -0.2"><joint name="{side}_knee" axis="0 1 0"/>
+                       <body name="{side}_foot" pos="0 0 {}"><joint name="{side}_ankle" axis="0 1 0"/>
+                         <geom type="box" size="0.08 0.04 0.01" pos="0.02 0 -0.01"/>
+                       </body></body></body>"#,
+                -0.23 + lift
+            )
+        };
+        let xml = format!(
+            r#"<mujoco><worldbody><body name="pelvis" pos="0 0 0.5"><freejoint/>
+                 <geom type="box" size="0.05 0.1 0.03"/>{}{}</body></worldbody></mujoco>"#,
+            leg("left", 0.1, 0.01),
+            leg("right", -0.1, 0.0)
+        );
+        let model = Model::from_xml_str(&xml, None).unwrap();
+        let foot = |name: &str| {
+            let body = model.body_id(name).unwrap();
+            RobotFoot::new(&model, body, body, 0, None)
+        };
+        let feet = [foot("left_foot"), foot("right_foot")];
+        let leg = leg_length(&model, &feet).unwrap();
+        assert!((leg - 0.45).abs() < 1e-9, "the longer leg: {leg}");
+        assert_eq!(leg_length(&model, &[feet[0].clone(), None]), None, "one foot");
+        // A foot under the other: no leg of its own.
+        let shin = model.body_id("left_shin").unwrap();
+        let hanging = [feet[0].clone(), RobotFoot::new(&model, shin, shin, 0, None)];
+        assert_eq!(leg_length(&model, &hanging), None);
+    }
+
+    #[test]
     fn only_a_frame_convention_is_turned_away() {
         let deg = f64::to_radians;
         assert!((convention_turn(deg(177.0)) - deg(180.0)).abs() < 1e-12, "Toddy's left calf");
