@@ -852,7 +852,6 @@ pub(crate) fn start_pose(
     Some(q)
 }
 
-/// Passes of the `[1, 2, 1] / 4` filter at `fps` that smooth as much, in seconds, as
 /// At most this many times [`PlausibleOptions::smoothing_passes`] for short legs
 /// ([`PlausibleOptions::smoothing_leg`]): legs of 0.19 m and longer are filtered as asked.
 pub const MAX_SMOOTHING_SCALE: f64 = 8.0;
@@ -867,6 +866,7 @@ pub fn smoothing_passes_for_leg(passes: usize, reference: f64, leg: Option<f64>)
     (passes as f64 * scale).round() as usize
 }
 
+/// Passes of the `[1, 2, 1] / 4` filter at `fps` that smooth as much, in seconds, as
 /// `passes_at_30` passes at 30 frames/s: `n` passes are a kernel of variance `n / 2` frames²,
 /// so the count scales with `(fps / 30)²` (at least one when any is asked for). At 120 fps one
 /// pass per frame left the CMU walk's jitter at 69 rad/s² against GMR's 50; 16 passes: 32.
