@@ -388,12 +388,6 @@ impl<'a> Prepared<'a> {
             leg_length: None,
             smoothing_passes: 0,
         };
-        if let SolveMode::Plausible(p) = &options.mode {
-            let feet = robot_feet(model, &prepared.stages);
-            prepared.leg_length = crate::feet::leg_length(model, &feet);
-            prepared.smoothing_passes =
-                smoothing_passes_for_leg(p.smoothing_passes, p.smoothing_leg, prepared.leg_length);
-        }
         // The source's contact phases are written in both modes (GMR's solve ignores them);
         // the default mode plants the feet on them.
         let contact = match &options.mode {
@@ -406,8 +400,16 @@ impl<'a> Prepared<'a> {
             prepared.contacts = Some(crate::contact::detect(human, points, &contact));
         }
         if let SolveMode::Plausible(plausible) = &options.mode {
+            // The robot's feet: their legs' length sets the smoothing, and they are planted.
+            let feet = robot_feet(model, &prepared.stages);
+            prepared.leg_length = crate::feet::leg_length(model, &feet);
+            prepared.smoothing_passes = smoothing_passes_for_leg(
+                plausible.smoothing_passes,
+                plausible.smoothing_leg,
+                prepared.leg_length,
+            );
             if plausible.planting == Planting::On {
-                prepared.plan_feet(plausible);
+                prepared.plan_feet(plausible, feet);
                 if prepared.plan.is_some() {
                     prepared.reweigh(plausible)?;
                 }
@@ -416,11 +418,11 @@ impl<'a> Prepared<'a> {
         Ok(prepared)
     }
 
-    /// Planted foot targets from the source contacts (when both the human's and the robot's
-    /// feet are found; otherwise the targets stay GMR's and only the constraints apply).
-    fn plan_feet(&mut self, options: &PlausibleOptions) {
+    /// Planted foot targets for the robot's `feet` from the source contacts (when both the
+    /// human's and the robot's feet are found; otherwise the targets stay GMR's and only the
+    /// constraints apply).
+    fn plan_feet(&mut self, options: &PlausibleOptions, feet: [Option<RobotFoot>; 2]) {
         let Some(contacts) = &self.contacts else { return };
-        let feet = robot_feet(self.model, &self.stages);
         let plan = crate::feet::plan(
             &feet,
             contacts,
