@@ -432,26 +432,21 @@ pub fn leg_length(model: &Model, feet: &[Option<RobotFoot>; 2]) -> Option<f64> {
     let [Some(a), Some(b)] = feet else { return None };
     let mut data = Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
-    // A body and its ancestors, the body first.
-    let path = |mut body: usize| {
-        let mut path = vec![body];
-        while body != 0 {
+    let leg = |foot: &RobotFoot, other: &RobotFoot| -> Option<f64> {
+        // Up from the foot until the bodies the other foot hangs from: the topmost body with
+        // a joint on the way is the hip.
+        let (mut body, mut hip) = (foot.body, None);
+        while !is_descendant(model, other.body, body) {
+            if model.bodies[body].jnt_num > 0 {
+                hip = Some(body);
+            }
             body = model.bodies[body].parent;
-            path.push(body);
         }
-        path
-    };
-    let (up_a, up_b) = (path(a.body), path(b.body));
-    let common = *up_a.iter().find(|x| up_b.contains(x))?;
-    let leg = |foot: &RobotFoot, up: &[usize]| -> Option<f64> {
-        let below = &up[..up.iter().position(|&x| x == common)?];
-        // The topmost joint of the leg: the last of the bodies below `common` that has one.
-        let hip = below.iter().rev().find(|&&body| model.bodies[body].jnt_num > 0)?;
-        let hip = data.xanchor[model.bodies[*hip].jnt_adr].z;
+        let hip = data.xanchor[model.bodies[hip?].jnt_adr].z;
         let sole = data.xpos[foot.body].z + foot.sole_offset(&foot.rest);
         Some(hip - sole)
     };
-    Some(leg(a, &up_a)?.max(leg(b, &up_b)?))
+    Some(leg(a, b)?.max(leg(b, a)?))
 }
 
 fn pose_of(pos: &Vector3<f64>, mat: &Matrix3<f64>) -> Isometry3<f64> {
