@@ -148,6 +148,19 @@ pub struct Joint {
     pub velocity_limit: Option<f64>,
 }
 
+impl Joint {
+    /// Where the joint's orientation quaternion `(w, x, y, z)` starts in `qpos`: after a free
+    /// joint's position, at a ball joint's address; `None` for hinges and slides.
+    #[must_use]
+    pub const fn quat_adr(&self) -> Option<usize> {
+        match self.kind {
+            JointType::Free => Some(self.qpos_adr + 3),
+            JointType::Ball => Some(self.qpos_adr),
+            JointType::Hinge | JointType::Slide => None,
+        }
+    }
+}
+
 /// A geom, placed in its body's frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Geom {

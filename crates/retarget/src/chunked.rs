@@ -78,11 +78,7 @@ pub fn retarget_motion_chunked(
 fn continue_quaternions(model: &Model, last: &[f64], qpos: &mut [f64]) {
     let nq = model.nq.max(1);
     for joint in &model.joints {
-        let at = match joint.kind {
-            mjcf::JointType::Free => joint.qpos_adr + 3,
-            mjcf::JointType::Ball => joint.qpos_adr,
-            mjcf::JointType::Hinge | mjcf::JointType::Slide => continue,
-        };
+        let Some(at) = joint.quat_adr() else { continue };
         let (Some(before), Some(first)) = (last.get(at..at + 4), qpos.get(at..at + 4)) else {
             continue;
         };

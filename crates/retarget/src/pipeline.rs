@@ -933,11 +933,7 @@ fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize, twicing: bool) 
         }
     }
     for joint in &model.joints {
-        let at = match joint.kind {
-            JointType::Free => joint.qpos_adr + 3,
-            JointType::Ball => joint.qpos_adr,
-            JointType::Hinge | JointType::Slide => continue,
-        };
+        let Some(at) = joint.quat_adr() else { continue };
         for t in 0..frames {
             let q = &mut out[t * nq + at..t * nq + at + 4];
             let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();

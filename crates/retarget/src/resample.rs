@@ -9,7 +9,7 @@
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
-use mjcf::{JointType, Model};
+use mjcf::Model;
 use nalgebra::{Quaternion, UnitQuaternion};
 
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
@@ -66,11 +66,7 @@ pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMo
 fn blend_qpos(model: &Model, a: &[f64], b: &[f64], t: f64) -> Vec<f64> {
     let mut out: Vec<f64> = a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect();
     for joint in &model.joints {
-        let quat_at = match joint.kind {
-            JointType::Free => joint.qpos_adr + 3,
-            JointType::Ball => joint.qpos_adr,
-            JointType::Hinge | JointType::Slide => continue,
-        };
+        let Some(quat_at) = joint.quat_adr() else { continue };
         let (Some(qa), Some(qb)) = (a.get(quat_at..quat_at + 4), b.get(quat_at..quat_at + 4))
         else {
             continue;
