@@ -27,15 +27,20 @@ fn default_chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial
     chunks_against_serial(RetargetOptions::default(), 1e-6);
 }
 
-fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
-    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
-        return;
-    };
+/// The G1, GMR's config for it, the shared LAFAN1 walk's human motion and the subject's
+/// height; `None` without the shared data.
+fn g1_walk() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
+    let walk = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh")?;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
     let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
     let bvh = bvh::from_path(&walk).unwrap();
-    let (full, report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
+    let (human, report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
+    Some((model, config, human, report.height))
+}
+
+fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
+    let Some((model, config, full, height)) = g1_walk() else { return };
     // The first 1,800 frames (a minute) keep the test short.
     let n = 1800;
     let nb = full.num_bodies();
@@ -45,7 +50,7 @@ fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
         orientations: full.orientations[..n * nb].to_vec(),
         ..full
     };
-    let options = RetargetOptions { human_height: Some(report.height), ..base };
+    let options = RetargetOptions { human_height: Some(height), ..base };
     let (serial, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     let chunk = ChunkOptions { frames: 300, lead_in: 60 };
     let (chunked, diag) =
@@ -78,15 +83,8 @@ fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
 /// quaternions are continuous and equal the serial solve's.
 #[test]
 fn chunk_seams_keep_the_root_quaternion_on_one_side_of_the_double_cover() {
-    let Some(walk) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
-        return;
-    };
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
-    let (human, report) =
-        fk::human_motion(&bvh::from_path(&walk).unwrap(), &fk::FkOptions::default()).unwrap();
-    let options = RetargetOptions { human_height: Some(report.height), ..RetargetOptions::gmr() };
+    let Some((model, config, human, height)) = g1_walk() else { return };
+    let options = RetargetOptions { human_height: Some(height), ..RetargetOptions::gmr() };
     let (serial, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     let chunk = ChunkOptions { frames: 600, lead_in: 60 };
     let (chunked, _) = retarget_motion_chunked(&human, &model, &config, &options, chunk).unwrap();
