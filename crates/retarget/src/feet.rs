@@ -27,11 +27,16 @@
 //! 4. **Swing clearance**: out of stance the target's sole stays at least
 //!    [`FootPlanOptions::swing_clearance`] above the floor. It rises to that height over
 //!    [`FootPlanOptions::lift_s`] after lift-off and comes down from it over the same time
-//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames. While it
-//!    rises or comes down it is held over its anchor, so it lifts off before it moves and
-//!    moves before it comes down. A foot is then either on the floor and still, or clear of
-//!    it. Without this, the swing foot skims the floor at the start and end of every step, a
-//!    few millimetres up and moving at a few dm/s.
+//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames (at 30 fps,
+//!    one frame, all the way up). While it rises or comes down, the point of the sole it last
+//!    stood on (or first lands on) stays where it was (will be) on the floor, seen from
+//!    above, and the foot turns about it to the free target's tilt: it lifts off before it
+//!    moves and moves before it comes down. A foot is then either on the floor and still, or
+//!    clear of it. Without this, the swing foot skims the floor at the start and end of every
+//!    step, a few millimetres up and moving at a few dm/s; and while the first frame of a
+//!    swing at 30 fps still moved with the free target (eased), the sole's last contact point
+//!    moved 5–7 mm sideways in it (median, the N1's LAFAN1 walk), and the report counted the
+//!    planted frame before it as sliding: 3.6 % of the G1 walk's contact frames, 0.9 % held.
 //!
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body; a foot without collision geometry stands on the
@@ -571,7 +576,8 @@ pub fn plan(
             }
         }
         let edges = swing_edges(&held.iter().map(Option::is_some).collect::<Vec<_>>());
-        let lift_frames = (options.lift_s * fps).ceil();
+        // (The tolerance: 1/30 s at 30 fps is one frame.)
+        let lift_frames = (options.lift_s * fps - 1e-9).ceil();
         for t in 0..frames {
             if held[t].is_some() {
                 weight[t][side] = options.stance_weight;
@@ -586,12 +592,12 @@ pub fn plan(
             if let Some((edge, frames_off)) = edges[t] {
                 // (The tolerance: at 30 fps and 1/30 s, one frame is all the way up.)
                 let rise = smoothstep((frames_off as f64 / (options.lift_s * fps) + 1e-9).min(1.0));
-                if rise < 1.0 {
-                    // Still rising (or already coming down): where the foot stood at the edge,
-                    // rolled as the free target is tilted.
-                    if let Some((xy, yaw)) = held[edge] {
-                        let over = planted_pose(foot, &pose, xy, yaw, options.clearance);
-                        (pose.pos.x, pose.pos.y, pose.quat) = (over.pos.x, over.pos.y, over.quat);
+                if frames_off as f64 <= lift_frames {
+                    // Rising (or coming down): the point the sole last touched the floor with
+                    // (or first touches it with) stays where it is, and the foot turns about
+                    // it to the free target's tilt.
+                    if let Some((_, yaw)) = held[edge] {
+                        pose = lifted_over(foot, &pose, &targets[edge * slots + foot.slot], yaw);
                         changed = true;
                     }
                 }
@@ -923,6 +929,22 @@ fn planted_pose(
     Pose { quat: [q.w, q.i, q.j, q.k], pos }
 }
 
+/// The free target `free` turned to `yaw`, placed so that the point of the sole lowest in the
+/// planted pose `edge` (the last or first of a stance phase) is where it is in `edge`, seen from
+/// above: the foot leaves the floor (or reaches it) over the point it last (first) stands on.
+/// (Its height is the swing clearance's.) A foot that moved its last contact point sideways
+/// in the frame after lift-off made the report's central differences count that planted
+/// frame as sliding.
+fn lifted_over(foot: &RobotFoot, free: &Pose, edge: &Pose, yaw: f64) -> Pose {
+    let at_edge = quat(edge);
+    let low = foot.sole_low_point(&at_edge);
+    let contact = edge.pos + at_edge * low;
+    let q = anchored(foot, free, yaw);
+    let turned = q * low;
+    let pos = Vector3::new(contact.x - turned.x, contact.y - turned.y, free.pos.z);
+    Pose { quat: [q.w, q.i, q.j, q.k], pos }
+}
+
 /// `a` (rad) wrapped into [−π, π).
 pub(crate) fn wrap(a: f64) -> f64 {
     (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
@@ -1106,6 +1128,50 @@ mod tests {
         let mid = (lift + touch) / 2;
         assert!(a[lift].pos.z - 0.02 >= eased.swing_clearance + eased.lift_margin - 1e-9);
         assert!(a[mid].pos.z - 0.02 < eased.swing_clearance + 1e-9);
+    }
+
+    #[test]
+    fn a_lifting_foot_leaves_over_the_point_it_last_stood_on() {
+        let options = FootPlanOptions::default();
+        for fps in [30.0, 60.0, 120.0] {
+            let mut foot = box_foot();
+            foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+            let frames = fps as usize;
+            let (lift, touch) = (frames / 3, 2 * frames / 3);
+            let labels: Vec<bool> = (0..frames).map(|t| t < lift || t >= touch).collect();
+            // Toes down by 10° throughout, stepping 0.5 m forward.
+            let toes_down = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.17);
+            let mut targets: Vec<Pose> = (0..frames)
+                .map(|t| {
+                    let u = ((t as f64 - lift as f64) / (touch - lift) as f64).clamp(0.0, 1.0);
+                    let q = toes_down.quaternion();
+                    Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.5 * u, 0.0, 0.04) }
+                })
+                .collect();
+            let contacts = FootContacts { left: labels, right: vec![false; frames] };
+            plan(&[Some(foot.clone()), None], &contacts, &mut targets, 1, fps, &options);
+            let lead = (options.lead_s * fps).round() as usize;
+            let hold = (options.lift_s * fps).round() as usize;
+            let point = |p: &Pose, local: &Vector3<f64>| p.pos + quat(p) * local;
+            for (edge, held) in
+                [(lift - 1, lift..lift + hold), (touch - lead, touch - lead - hold..touch - lead)]
+            {
+                let local = foot.sole_low_point(&quat(&targets[edge]));
+                assert!(local.x > 0.09, "fps {fps}: the toe is the lowest point");
+                let on_floor = point(&targets[edge], &local);
+                for t in held {
+                    let p = point(&targets[t], &local);
+                    let d = (p - on_floor).xy().norm();
+                    assert!(
+                        d < 1e-9 && p.z > on_floor.z + 1e-3,
+                        "fps {fps} frame {t}: {d}, {}",
+                        p.z
+                    );
+                }
+            }
+            // Then it moves.
+            assert!(targets[lift + hold].pos.x > targets[lift - 1].pos.x + 0.01, "fps {fps}");
+        }
     }
 
     #[test]
