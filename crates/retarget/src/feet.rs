@@ -90,7 +90,8 @@ pub struct FootPlanOptions {
     /// other are also kept this far apart sideways (`keep_feet_apart`), before planting.
     pub sole_gap: f64,
     /// Least height (m) of the sole's lowest point above the floor out of stance, once the
-    /// foot has risen ([`FootPlanOptions::lift_s`]).
+    /// foot has risen ([`FootPlanOptions::lift_s`]). The repair after the smoothing filter
+    /// lifts a swing sole found below it back up ([`FootPlan::swing_floor`]).
     pub swing_clearance: f64,
     /// Time (s) over which the swing clearance fades in after lift-off and out before
     /// touch-down (smoothstep).
@@ -469,6 +470,9 @@ pub struct FootPlan {
     /// Per frame and foot in stance: points of the sole (foot frame), where they stay
     /// (world), and which world axes hold them ([`SolePoint`]).
     pub contact: Vec<[Vec<SolePoint>; 2]>,
+    /// Per frame and foot out of stance: the least height (m) above the floor the swing
+    /// clearance asks of the sole's lowest point, where it asks any.
+    pub swing_floor: Vec<[Option<f64>; 2]>,
 }
 
 /// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
@@ -493,6 +497,7 @@ pub fn plan(
     let lead = (options.lead_s * fps).round().max(0.0) as usize;
     let mut weight = vec![[1.0; 2]; frames];
     let mut contact = vec![[Vec::new(), Vec::new()]; frames];
+    let mut swing_floor = vec![[None; 2]; frames];
     // Each foot's stance phases and their anchors, (range, xy, yaw), then kept apart.
     let mut anchors: [Vec<Planted>; 2] = [Vec::new(), Vec::new()];
     let mut free_targets: [Vec<Pose>; 2] = [Vec::new(), Vec::new()];
@@ -604,6 +609,9 @@ pub fn plan(
                 let margin =
                     if frames_off as f64 <= lift_frames { options.lift_margin } else { 0.0 };
                 let height = (options.swing_clearance + margin) * rise;
+                if height > 0.0 {
+                    swing_floor[t][side] = Some(height);
+                }
                 let low = height - pose.pos.z - foot.sole_offset(&quat(&pose));
                 if low > 0.0 {
                     pose.pos.z += low;
@@ -619,7 +627,7 @@ pub fn plan(
             }
         }
     }
-    FootPlan { shift, weight, contact }
+    FootPlan { shift, weight, contact, swing_floor }
 }
 
 /// The part of a mean yaw difference (rad) between a foot's target and the foot its shin's
