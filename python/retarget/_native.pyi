@@ -101,7 +101,8 @@ class Retargeter:
         fps: float = 30.0,
     ) -> None:
         """``mode``: ``"default"`` (planted feet, constraints, smoothing), ``"gmr"`` (GMR's
-        exact solve) or ``"causal"`` (what ``step`` runs, on a whole clip)."""
+        exact solve), ``"causal"`` (what ``step`` runs, on a whole clip) or ``"both_ways"``
+        (the default, also solved backwards where that tracks better: ``--both-ways``)."""
     @property
     def robot(self) -> str: ...
     @property

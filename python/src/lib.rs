@@ -59,9 +59,16 @@ fn options_for(mode: &str, human_height: Option<f64>) -> PyResult<RetargetOption
         "default" | "plausible" => RetargetOptions::default(),
         "gmr" => RetargetOptions::gmr(),
         "causal" => RetargetOptions::causal(),
+        "both_ways" => RetargetOptions {
+            mode: retarget::SolveMode::Plausible(retarget::PlausibleOptions {
+                both_ways: true,
+                ..Default::default()
+            }),
+            ..RetargetOptions::default()
+        },
         other => {
             return Err(PyValueError::new_err(format!(
-                "mode {other:?}: expected \"default\", \"gmr\" or \"causal\""
+                "mode {other:?}: expected \"default\", \"gmr\", \"causal\" or \"both_ways\""
             )))
         }
     };
@@ -95,8 +102,10 @@ fn build(
 ///         for LAFAN1-named skeletons on shipped robots, else one derived from the skeleton's
 ///         and the robot's roles; for frames, the shipped robot's tuned config.
 ///     mode: ``"default"`` (planted feet, ground, self-collision and joint-speed
-///         constraints, a smoothing pass), ``"gmr"`` (GMR's exact solve) or ``"causal"``
-///         (the default's constraints without planting or smoothing: what ``step`` runs).
+///         constraints, a smoothing pass), ``"gmr"`` (GMR's exact solve), ``"causal"``
+///         (the default's constraints without planting or smoothing: what ``step`` runs) or
+///         ``"both_ways"`` (the default, its first pass also run backwards, the better
+///         direction taken where the two agree: ``retarget --both-ways``).
 ///     human_height: subject height in metres. Default: estimated from a BVH skeleton; the
 ///         config's ``human_height_assumption`` for frames.
 ///     fps: frame rate of streamed frames (``step``), for the joint speed limits.

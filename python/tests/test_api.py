@@ -89,3 +89,16 @@ def test_quickstart_example_runs(tmp_path, root, walk):
     assert "Motion(robot=\"unitree_g1\", frames=7184" in result.stdout
     saved = np.load(tmp_path / "walk_g1.npz")
     assert saved["qpos"].shape == (7184, 36)
+
+
+def test_both_ways_takes_a_stuck_hip_from_the_backward_pass(shared):
+    """The PM01's right hip goes over into its other branch in the Bandai kick and stays there
+    in the default solve; solved both ways it does not (as `retarget --both-ways`)."""
+    kick = shared / "data/bvh/bandai_dataset-1_kick_normal_001.bvh"
+    over = {}
+    for mode in ("default", "both_ways"):
+        motion = retarget.Retargeter("engineai_pm01", mode=mode).retarget_bvh(kick)
+        yaw = motion.joint_pos[:, motion.joint_names.index("J08_HIP_YAW_R")]
+        over[mode] = int((np.abs(yaw) > np.radians(150)).sum())
+    assert over["default"] > 100 and over["both_ways"] == 0, over
+

@@ -56,6 +56,10 @@ pub struct BatchArgs {
     /// self-collision or joint-speed constraints). Default: the physically plausible solve.
     #[arg(long)]
     pub gmr: bool,
+    /// Also solve each clip backwards and take the better direction wherever the two agree
+    /// (as the main command's --both-ways).
+    #[arg(long, conflicts_with = "gmr")]
+    pub both_ways: bool,
     /// Split clips longer than this many frames into chunks solved in parallel (each warm-
     /// started from a lead-in; on the LAFAN1 walk the result equals the serial solve to
     /// 3.7e-10 rad with --gmr, 1.1e-4 rad with the default solve).
@@ -88,7 +92,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
         chunk: args
             .chunk_frames
             .map(|frames| retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in }),
-        mode: if args.gmr { retarget::SolveMode::Gmr } else { retarget::SolveMode::default() },
+        mode: crate::cmd_retarget::solve_mode(args.gmr, args.both_ways),
         ..RetargetOptions::default()
     };
     let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;

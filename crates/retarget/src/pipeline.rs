@@ -102,6 +102,15 @@ pub struct PlausibleOptions {
     /// (pelvis weight 100 too) 0–0.5 cm on CMU, Mixamo, Rigify and the Bandai kick and run,
     /// 0.5–1.8 cm on the Bandai walks and dance (their scales come from the robot's limbs).
     pub pelvis_offset_range: [f64; 2],
+    /// Also run the first pass backwards, from the clip's last frame to its first, and
+    /// hand over to it where it tracks better (the sum of the frames' tracking errors lower by
+    /// more than the median frame's error per switch, switching only where the two passes
+    /// agree to 0.05 rad and 5 cm, so that no switch is a jump). A warm-started solve keeps
+    /// the branch a limb is in: on the Bandai kick the PM01's right hip went over into the
+    /// hip's other branch (pitch and roll at their limits, yaw −200°) for the 300 frames after
+    /// the kick, and the backward pass, which reaches the kick from the normal stance, never
+    /// does. Costs a second first pass.
+    pub both_ways: bool,
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
     pub repair_steps: usize,
@@ -147,6 +156,7 @@ impl Default for PlausibleOptions {
             trunk_rotation_scale: 2.0,
             root_position_weight_cap: 20.0,
             pelvis_offset_range: [0.005, 0.015],
+            both_ways: false,
             repair_weight: 1000.0,
             repair_steps: 1,
             max_extra_steps: 10,
@@ -156,14 +166,15 @@ impl Default for PlausibleOptions {
 
 impl PlausibleOptions {
     /// The causal part of the default solve: GMR's tasks with the hard constraints (ground,
-    /// self-collision, joint speed), warm-started frame by frame; no foot planting and no
-    /// smoothing, which both need the frames that follow. What streaming
+    /// self-collision, joint speed), warm-started frame by frame; no foot planting, no
+    /// smoothing and no backward pass, which all need the frames that follow. What streaming
     /// ([`crate::Retargeter::step`]) runs; a clip solved with it gives the same numbers.
     #[must_use]
     pub fn causal() -> PlausibleOptions {
         PlausibleOptions {
             planting: Planting::Off,
             smoothing_passes: 0,
+            both_ways: false,
             ..PlausibleOptions::default()
         }
     }
@@ -539,6 +550,11 @@ impl<'a> Prepared<'a> {
             reject_divergence(solver.qpos(), f)?;
             qpos.extend_from_slice(solver.qpos());
         }
+        if matches!(&self.options.mode, SolveMode::Plausible(p) if p.both_ways) {
+            let (back, back_frames) = self.first_pass_backward(first..end)?;
+            let coords = compared_coordinates(self.model);
+            splice_passes(nq, &coords, &mut qpos, &mut frames, &back, &back_frames);
+        }
         if let SolveMode::Plausible(p) = &self.options.mode {
             if passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, passes, twicing);
@@ -627,6 +643,24 @@ impl<'a> Prepared<'a> {
             solver.solve_frame(targets, first_frame_dt(first, self.frame_dt()))?
         };
         Ok(diagnostics)
+    }
+
+    /// The first pass run backwards over `range`: from its last frame (solved as a first
+    /// frame) to its first, each frame warm-started from the one after it.
+    fn first_pass_backward(
+        &self,
+        range: Range<usize>,
+    ) -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
+        let mut solver = self.solver()?;
+        let nq = self.model.nq;
+        let mut qpos = vec![0.0; range.len() * nq];
+        let mut frames = vec![FrameDiagnostics::default(); range.len()];
+        for (k, f) in range.clone().enumerate().rev() {
+            frames[k] = self.first_pass_frame(&mut solver, f, f + 1 == range.end)?;
+            reject_divergence(solver.qpos(), f)?;
+            qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
+        }
+        Ok((qpos, frames))
     }
 
     /// Seconds between frames (0 for a clip without a rate).
@@ -1141,6 +1175,90 @@ fn diverged(qpos: &[f64]) -> bool {
 }
 
 /// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
+/// Joints of two solutions closer than this (rad, m) in every hinge and slide coordinate
+/// and the free root's position: the same branch, where one pass may hand over to the other.
+const PASSES_AGREE: f64 = 0.05;
+
+/// The coordinates [`splice_passes`] compares: every hinge and slide joint's and the free
+/// root's position (its quaternion turns with the joints below it).
+fn compared_coordinates(model: &Model) -> Vec<usize> {
+    model
+        .joints
+        .iter()
+        .flat_map(|j| match j.kind {
+            JointType::Hinge | JointType::Slide => j.qpos_adr..j.qpos_adr + 1,
+            JointType::Free => j.qpos_adr..j.qpos_adr + 3,
+            JointType::Ball => j.qpos_adr..j.qpos_adr,
+        })
+        .collect()
+}
+
+/// Replaces stretches of the forward first pass (`qpos`, `frames`: `nq` numbers and one
+/// diagnostics per frame) by the backward one's (`back`, `back_frames`) where that lowers the
+/// sum of the frames' tracking errors by more than a typical frame's error per switch,
+/// switching only between frames where the two agree in every coordinate of `coords`
+/// ([`PASSES_AGREE`]), so that no switch is a jump. Returns the frames (indices into the
+/// range) where the result switches from one pass to the other.
+fn splice_passes(
+    nq: usize,
+    coords: &[usize],
+    qpos: &mut [f64],
+    frames: &mut [FrameDiagnostics],
+    back: &[f64],
+    back_frames: &[FrameDiagnostics],
+) -> Vec<usize> {
+    let n = frames.len();
+    if n == 0 || back.len() != qpos.len() || qpos.len() != n * nq || back_frames.len() != n {
+        return Vec::new();
+    }
+    let agree = |t: usize| {
+        coords.iter().all(|&c| (qpos[t * nq + c] - back[t * nq + c]).abs() < PASSES_AGREE)
+    };
+    let error = |side: usize, t: usize| {
+        if side == 0 {
+            frames[t].error
+        } else {
+            back_frames[t].error
+        }
+    };
+    // Each switch costs as much as a typical frame's error, so that the passes do not trade
+    // places for hundredths where they agree.
+    let mut sorted: Vec<f64> = frames.iter().map(|f| f.error).collect();
+    sorted.sort_by(f64::total_cmp);
+    let penalty = sorted[n / 2];
+    // The least total error up to frame t on each side, and the side frame t − 1 is on.
+    // (Starting on the backward pass counts as a switch.)
+    let mut cost = [error(0, 0), error(1, 0) + penalty];
+    let mut from = vec![[0usize, 1usize]; n];
+    for (t, came) in from.iter_mut().enumerate().skip(1) {
+        let can_switch = agree(t - 1);
+        let mut next = [0.0; 2];
+        for side in 0..2 {
+            let (stay, switch) = (cost[side], cost[1 - side] + penalty);
+            if can_switch && switch < stay {
+                (next[side], came[side]) = (switch + error(side, t), 1 - side);
+            } else {
+                (next[side], came[side]) = (stay + error(side, t), side);
+            }
+        }
+        cost = next;
+    }
+    let mut side = usize::from(cost[1] < cost[0]);
+    let mut switches = Vec::new();
+    for t in (0..n).rev() {
+        if side == 1 {
+            qpos[t * nq..(t + 1) * nq].copy_from_slice(&back[t * nq..(t + 1) * nq]);
+            frames[t] = back_frames[t].clone();
+        }
+        if from[t][side] != side {
+            switches.push(t);
+        }
+        side = from[t][side];
+    }
+    switches.reverse();
+    switches
+}
+
 pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
     if diverged(qpos) {
         return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });
@@ -1154,7 +1272,51 @@ pub(crate) fn finite_pose(p: &Pose) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::{diverged, smoothing_passes_at, smoothing_passes_for_leg};
+    use super::{diverged, smoothing_passes_at, smoothing_passes_for_leg, splice_passes};
+    use crate::solver::FrameDiagnostics;
+
+    /// One coordinate per frame, and the frames' errors.
+    fn pass(q: &[f64], errors: &[f64]) -> (Vec<f64>, Vec<FrameDiagnostics>) {
+        let frames = errors.iter().map(|&error| FrameDiagnostics { error, ..Default::default() });
+        (q.to_vec(), frames.collect())
+    }
+
+    #[test]
+    fn a_forward_pass_stuck_in_another_branch_hands_over_where_the_two_agree() {
+        // Forward: fine for 4 frames, then a branch 1 rad away with twice the error.
+        let (mut q, mut f) = pass(&[0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0], &[1.0; 8]);
+        for d in &mut f[4..] {
+            d.error = 2.0;
+        }
+        let (b, bf) = pass(&[0.01, 0.01, 0.0, 0.02, 0.1, 0.1, 0.1, 0.1], &[1.1; 8]);
+        let switches = splice_passes(1, &[0], &mut q, &mut f, &b, &bf);
+        // The last frame both agree on is 3; the backward pass from frame 4 on.
+        assert_eq!(switches, vec![4]);
+        assert_eq!(q, vec![0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.1, 0.1]);
+        assert!(f[4..].iter().all(|d| d.error == 1.1));
+    }
+
+    #[test]
+    fn passes_that_never_agree_or_gain_little_are_not_spliced() {
+        let (q0, f0) = pass(&[0.0, 0.0, 1.0, 1.0], &[1.0, 1.0, 2.0, 2.0]);
+        // Never within reach of each other: no switch, even though the backward pass is
+        // better from frame 2 on (by less than a typical frame's error in all).
+        let (b, bf) = pass(&[0.5, 0.5, 0.5, 0.5], &[1.2, 1.2, 1.0, 1.0]);
+        let (mut q, mut f) = (q0.clone(), f0.clone());
+        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert_eq!(q, q0);
+        // Agreeing everywhere, but better by less than a typical frame's error in all: kept.
+        let (q1, f1) = pass(&[0.0; 4], &[1.0; 4]);
+        let (b, bf) = pass(&[0.01; 4], &[0.9, 0.9, 0.9, 1.0]);
+        let (mut q, mut f) = (q1.clone(), f1.clone());
+        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert_eq!(q, q1);
+        // A backward pass better throughout from its first frame on is taken whole.
+        let (b, bf) = pass(&[0.5; 4], &[0.1; 4]);
+        let (mut q, mut f) = (q0.clone(), f0.clone());
+        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert_eq!(q, vec![0.5; 4]);
+    }
 
     #[test]
     fn short_legs_are_smoothed_over_more_passes() {

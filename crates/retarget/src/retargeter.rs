@@ -499,6 +499,7 @@ fn stream_options(options: &RetargetOptions) -> RetargetOptions {
         out.mode = SolveMode::Plausible(PlausibleOptions {
             planting: causal.planting,
             smoothing_passes: causal.smoothing_passes,
+            both_ways: causal.both_ways,
             ..p.clone()
         });
     }

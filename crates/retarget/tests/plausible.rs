@@ -348,3 +348,38 @@ fn the_first_frame_starts_where_the_arms_can_follow() {
     let hand = tracking.iter().find(|b| b.body == "right_hand_link").unwrap();
     assert!(hand.rot_rad.mean < 0.35, "right hand {:.2} rad off", hand.rot_rad.mean);
 }
+
+/// On the Bandai kick the PM01's right hip goes over into its other branch (pitch and roll at
+/// their limits, yaw past −150°) as the leg comes up, and the warm-started solve keeps it
+/// there for the rest of the take. Solved both ways ([`retarget::PlausibleOptions::both_ways`]),
+/// the backward pass, which reaches the kick from the take's normal end, takes over, and the
+/// hip stays in its normal branch throughout.
+#[test]
+fn a_limb_stuck_in_another_branch_is_taken_from_the_backward_pass() {
+    let Some(path) = shared::shared_file("data/bvh/bandai_dataset-1_kick_normal_001.bvh") else {
+        return;
+    };
+    let solve = |both_ways| {
+        let mode = retarget::SolveMode::Plausible(retarget::PlausibleOptions {
+            both_ways,
+            ..Default::default()
+        });
+        let r = retarget::Retargeter::new("engineai_pm01").unwrap().with_mode(mode);
+        let (motion, _) = r.retarget_bvh_file(&path).unwrap();
+        let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
+        let joint = &r.model().joints[r.model().joint_id("J08_HIP_YAW_R").unwrap()];
+        let nq = motion.nq;
+        let over = (0..motion.num_frames())
+            .filter(|&t| motion.qpos[t * nq + joint.qpos_adr].abs() > 150f64.to_radians())
+            .count();
+        (over, report)
+    };
+    let (over_forward, forward) = solve(false);
+    let (over_both, both) = solve(true);
+    assert!(over_forward > 100, "the forward solve alone: {over_forward} frames over");
+    assert_eq!(over_both, 0);
+    let (rot_f, rot_b) = (mean_rot_error_deg(&forward), mean_rot_error_deg(&both));
+    assert!(rot_b < rot_f, "rotation error {rot_b:.2}° against {rot_f:.2}° forward only");
+    assert_eq!(both.ground_penetration.frames, 0);
+    assert_eq!(both.joint_speed.as_ref().unwrap().violations, 0);
+}
