@@ -552,8 +552,8 @@ impl<'a> Prepared<'a> {
         }
         if matches!(&self.options.mode, SolveMode::Plausible(p) if p.both_ways) {
             let (back, back_frames) = self.first_pass_backward(first..end)?;
-            let coords = compared_coordinates(self.model);
-            splice_passes(nq, &coords, &mut qpos, &mut frames, &back, &back_frames);
+            let (coords, quats) = compared_coordinates(self.model);
+            splice_passes(nq, (&coords, &quats), &mut qpos, &mut frames, &back, &back_frames);
         }
         if let SolveMode::Plausible(p) = &self.options.mode {
             if passes > 0 && !qpos.is_empty() {
@@ -687,8 +687,8 @@ impl<'a> Prepared<'a> {
     /// The smoothing filter pulls a swing foot towards its planted neighbours' height, the
     /// further the more passes it has: ToddlerBot's (8 passes) swung 2.6–2.9 cm up (median)
     /// in 1,500 of its LAFAN1 walk's frames, under the report's 3 cm contact height, and the
-    /// report counted 12.4 % of its contact frames as sliding (2.0 % lifted; the G1's jumps
-    /// 6.5 → 5.4 %).
+    /// report counted 12.4 % of its contact frames as sliding (1.6 % lifted; the G1's jumps
+    /// 6.5 → 5.3 %).
     fn set_frame_tasks_at(
         &self,
         solver: &mut Solver<'_>,
@@ -1179,10 +1179,11 @@ fn diverged(qpos: &[f64]) -> bool {
 /// and the free root's position: the same branch, where one pass may hand over to the other.
 const PASSES_AGREE: f64 = 0.05;
 
-/// The coordinates [`splice_passes`] compares: every hinge and slide joint's and the free
-/// root's position (its quaternion turns with the joints below it).
-fn compared_coordinates(model: &Model) -> Vec<usize> {
-    model
+/// What [`splice_passes`] compares: every hinge and slide joint's coordinate and the free
+/// root's position, and where each free or ball joint's quaternion starts (compared by the
+/// angle between the two).
+fn compared_coordinates(model: &Model) -> (Vec<usize>, Vec<usize>) {
+    let scalars = model
         .joints
         .iter()
         .flat_map(|j| match j.kind {
@@ -1190,7 +1191,8 @@ fn compared_coordinates(model: &Model) -> Vec<usize> {
             JointType::Free => j.qpos_adr..j.qpos_adr + 3,
             JointType::Ball => j.qpos_adr..j.qpos_adr,
         })
-        .collect()
+        .collect();
+    (scalars, model.joints.iter().filter_map(mjcf::Joint::quat_adr).collect())
 }
 
 /// Replaces stretches of the forward first pass (`qpos`, `frames`: `nq` numbers and one
@@ -1201,7 +1203,7 @@ fn compared_coordinates(model: &Model) -> Vec<usize> {
 /// range) where the result switches from one pass to the other.
 fn splice_passes(
     nq: usize,
-    coords: &[usize],
+    (coords, quats): (&[usize], &[usize]),
     qpos: &mut [f64],
     frames: &mut [FrameDiagnostics],
     back: &[f64],
@@ -1212,7 +1214,14 @@ fn splice_passes(
         return Vec::new();
     }
     let agree = |t: usize| {
-        coords.iter().all(|&c| (qpos[t * nq + c] - back[t * nq + c]).abs() < PASSES_AGREE)
+        let (a, b) = (&qpos[t * nq..(t + 1) * nq], &back[t * nq..(t + 1) * nq]);
+        let apart = |q: usize| {
+            let dot = |x: &[f64], y: &[f64]| (0..4).map(|i| x[q + i] * y[q + i]).sum::<f64>();
+            let norms = (dot(a, a) * dot(b, b)).sqrt().max(f64::MIN_POSITIVE);
+            2.0 * (dot(a, b).abs() / norms).min(1.0).acos()
+        };
+        coords.iter().all(|&c| (a[c] - b[c]).abs() < PASSES_AGREE)
+            && quats.iter().all(|&q| apart(q) < PASSES_AGREE)
     };
     let error = |side: usize, t: usize| {
         if side == 0 {
@@ -1289,7 +1298,7 @@ mod tests {
             d.error = 2.0;
         }
         let (b, bf) = pass(&[0.01, 0.01, 0.0, 0.02, 0.1, 0.1, 0.1, 0.1], &[1.1; 8]);
-        let switches = splice_passes(1, &[0], &mut q, &mut f, &b, &bf);
+        let switches = splice_passes(1, (&[0], &[]), &mut q, &mut f, &b, &bf);
         // The last frame both agree on is 3; the backward pass from frame 4 on.
         assert_eq!(switches, vec![4]);
         assert_eq!(q, vec![0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.1, 0.1]);
@@ -1303,18 +1312,31 @@ mod tests {
         // better from frame 2 on (by less than a typical frame's error in all).
         let (b, bf) = pass(&[0.5, 0.5, 0.5, 0.5], &[1.2, 1.2, 1.0, 1.0]);
         let (mut q, mut f) = (q0.clone(), f0.clone());
-        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert!(splice_passes(1, (&[0], &[]), &mut q, &mut f, &b, &bf).is_empty());
         assert_eq!(q, q0);
         // Agreeing everywhere, but better by less than a typical frame's error in all: kept.
         let (q1, f1) = pass(&[0.0; 4], &[1.0; 4]);
         let (b, bf) = pass(&[0.01; 4], &[0.9, 0.9, 0.9, 1.0]);
         let (mut q, mut f) = (q1.clone(), f1.clone());
-        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert!(splice_passes(1, (&[0], &[]), &mut q, &mut f, &b, &bf).is_empty());
         assert_eq!(q, q1);
+        // A coordinate and a quaternion per frame; the backward pass better from frame 2 on,
+        // and worse before, so only a switch gains. A quaternion of the opposite sign agrees;
+        // one turned 90° apart does not.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let forward: Vec<f64> = [0.0, 1.0, 0.0, 0.0, 0.0].repeat(4);
+        let (_, ff) = pass(&[0.0; 4], &[1.0, 1.0, 2.0, 2.0]);
+        let (_, bf) = pass(&[0.0; 4], &[3.0, 3.0, 0.5, 0.5]);
+        for (back, switched) in [([0.0, -1.0, 0.0, 0.0, 0.0], true), ([0.0, h, 0.0, 0.0, h], false)]
+        {
+            let (mut q, mut f) = (forward.clone(), ff.clone());
+            let spliced = splice_passes(5, (&[0], &[1]), &mut q, &mut f, &back.repeat(4), &bf);
+            assert_eq!(spliced, if switched { vec![2] } else { vec![] }, "{back:?}");
+        }
         // A backward pass better throughout from its first frame on is taken whole.
         let (b, bf) = pass(&[0.5; 4], &[0.1; 4]);
         let (mut q, mut f) = (q0.clone(), f0.clone());
-        assert!(splice_passes(1, &[0], &mut q, &mut f, &b, &bf).is_empty());
+        assert!(splice_passes(1, (&[0], &[]), &mut q, &mut f, &b, &bf).is_empty());
         assert_eq!(q, vec![0.5; 4]);
     }
 

@@ -233,7 +233,7 @@ fn a_short_legged_robot_is_smoother_than_gmr_and_its_swing_feet_stay_up() {
     assert!(rot_d < 1.1 * rot_g, "rotation error {rot_d:.2}° against GMR's {rot_g:.2}°");
     // The smoothing over 8 passes pulled the swing feet under the report's 3 cm contact
     // height, moving: 12.4 % of the contact frames slid (GMR's solve 20.6 %) until the
-    // repair lifted them back to their swing clearance (2.0 %).
+    // repair lifted them back to their swing clearance (1.6 %).
     let (s_d, s_g) = (sliding_share(&default), sliding_share(&gmr));
     assert!(s_d < 0.25 * s_g, "sliding share {s_d:.3} against GMR's {s_g:.3}");
 }
