@@ -109,7 +109,7 @@ pub struct PlausibleOptions {
     /// the branch a limb is in: on the Bandai kick the PM01's right hip went over into the
     /// hip's other branch (pitch and roll at their limits, yaw −200°) for the 300 frames after
     /// the kick, and the backward pass, which reaches the kick from the normal stance, never
-    /// does. Costs a second first pass.
+    /// does. Costs a second first pass, run on a second thread of rayon's pool.
     pub both_ways: bool,
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
@@ -539,22 +539,34 @@ impl<'a> Prepared<'a> {
         let reach = if twicing { 2 * passes } else { passes };
         let end = (range.end + reach).min(self.num_frames());
         let dt = self.frame_dt();
-        let mut qpos = Vec::with_capacity((end - first) * nq);
-        let mut frames = Vec::with_capacity(end - first);
         // Both passes hold every constraint. (A first pass under box bounds only is 1.4×
         // faster on the G1, but on robots whose tracking drives links into each other, e.g.
         // Toddy's hips, one repair step then cannot get out within the speed limits and drops
         // the self-collision rows: 1402 frames > 1 cm against 14.)
-        for f in first..end {
-            frames.push(self.first_pass_frame(&mut solver, f, f == first)?);
-            reject_divergence(solver.qpos(), f)?;
-            qpos.extend_from_slice(solver.qpos());
-        }
-        if matches!(&self.options.mode, SolveMode::Plausible(p) if p.both_ways) {
-            let (back, back_frames) = self.first_pass_backward(first..end)?;
+        let forward =
+            |solver: &mut Solver<'_>| -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
+                let mut qpos = Vec::with_capacity((end - first) * nq);
+                let mut frames = Vec::with_capacity(end - first);
+                for f in first..end {
+                    frames.push(self.first_pass_frame(solver, f, f == first)?);
+                    reject_divergence(solver.qpos(), f)?;
+                    qpos.extend_from_slice(solver.qpos());
+                }
+                Ok((qpos, frames))
+            };
+        let (mut qpos, mut frames) = if matches!(&self.options.mode, SolveMode::Plausible(p) if p.both_ways)
+        {
+            // The two directions on two threads of rayon's pool (one, in a busy pool, is
+            // the same work in turn).
+            let (ahead, back) =
+                rayon::join(|| forward(&mut solver), || self.first_pass_backward(first..end));
+            let ((mut qpos, mut frames), (back, back_frames)) = (ahead?, back?);
             let (coords, quats) = compared_coordinates(self.model);
             splice_passes(nq, (&coords, &quats), &mut qpos, &mut frames, &back, &back_frames);
-        }
+            (qpos, frames)
+        } else {
+            forward(&mut solver)?
+        };
         if let SolveMode::Plausible(p) = &self.options.mode {
             if passes > 0 && !qpos.is_empty() {
                 let smooth = smooth_trajectory(self.model, &qpos, passes, twicing);
