@@ -80,6 +80,10 @@ class Motion:
     def smoothing(self) -> Tuple[Optional[float], int]:
         """The robot's standing leg length (m, or None) and the default solve's smoothing
         passes at 30 frames/s (more for legs under 0.55 m; 0 for GMR's solve)."""
+    @property
+    def backward(self) -> Tuple[int, int]:
+        """Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise)
+        and the stretches they form."""
     def to_dict(self) -> Dict[str, np.ndarray]:
         """Every array of the ``.npz`` exactly as ``numpy.load`` gives it."""
     def save(self, path: PathLike, format: Optional[str] = None) -> None:

@@ -492,6 +492,13 @@ impl Motion {
         (self.diag.leg_length, self.diag.smoothing_passes)
     }
 
+    /// Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise) and
+    /// the stretches they form.
+    #[getter]
+    fn backward(&self) -> (usize, usize) {
+        self.diag.from_backward()
+    }
+
     /// Every array of the ``.npz`` by key, exactly as ``numpy.load`` gives them (``fps`` of
     /// shape (1,), names as unicode arrays).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

@@ -100,5 +100,7 @@ def test_both_ways_takes_a_stuck_hip_from_the_backward_pass(shared):
         motion = retarget.Retargeter("engineai_pm01", mode=mode).retarget_bvh(kick)
         yaw = motion.joint_pos[:, motion.joint_names.index("J08_HIP_YAW_R")]
         over[mode] = int((np.abs(yaw) > np.radians(150)).sum())
+        frames, stretches = motion.backward
+        assert (frames > 0 and stretches > 0) == (mode == "both_ways"), motion.backward
     assert over["default"] > 100 and over["both_ways"] == 0, over
 

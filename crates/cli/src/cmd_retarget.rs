@@ -142,7 +142,7 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         None => write_motion(&output, &motion, model, format)?,
     }
     let wall = started.elapsed().as_secs_f64();
-    print_summary(&input, &output, &motion, &diag, wall);
+    print_summary(&input, &output, &motion, &diag, wall, args.both_ways);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -177,6 +177,7 @@ fn print_summary(
     motion: &RobotMotion,
     diag: &ClipDiagnostics,
     wall: f64,
+    both_ways: bool,
 ) {
     let frames = motion.num_frames();
     println!(
@@ -201,6 +202,14 @@ fn print_summary(
         println!(
             "default solve: legs {:.2} m long, trajectory smoothed over {} passes at 30 frames/s",
             leg, diag.smoothing_passes
+        );
+    }
+    if both_ways {
+        let (backward, stretches) = diag.from_backward();
+        let plural = if stretches == 1 { "" } else { "es" };
+        println!(
+            "both ways: {backward} of {frames} frames from the backward pass, in {stretches} \
+             stretch{plural}"
         );
     }
     println!(

@@ -141,6 +141,27 @@ fn help_names_required_arguments_and_describes_every_argument() {
     assert!(help_entries(&batch)["-o, --output <OUTPUT>"].contains("(required"), "{batch}");
 }
 
+/// `--both-ways` says how much of the clip came from the backward pass, and is not GMR's.
+#[test]
+fn both_ways_reports_what_it_took_from_the_backward_pass() {
+    let Some(kick) = shared::shared_file("data/bvh/bandai_dataset-1_kick_normal_001.bvh") else {
+        return;
+    };
+    let dir = temp_dir("both_ways");
+    let out_path = dir.join("kick.npz");
+    let args = ["--bvh", kick.to_str().unwrap(), "--robot", "engineai_pm01", "-o"];
+    let out = retarget(&[&args[..], &[out_path.to_str().unwrap(), "--both-ways"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let line = text.lines().find(|l| l.starts_with("both ways: ")).unwrap_or_default();
+    let taken: usize = line["both ways: ".len()..].split(' ').next().unwrap().parse().unwrap();
+    assert!(taken > 100 && line.contains(" of 358 frames from the backward pass"), "{text}");
+    let out =
+        retarget(&[&args[..], &[out_path.to_str().unwrap(), "--both-ways", "--gmr"]].concat());
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("cannot be used with"), "{}", stderr(&out));
+}
+
 #[test]
 fn main_command_and_batch_take_the_same_options() {
     let main = help_entries(&stdout(&retarget(&["--help"])));
@@ -155,6 +176,7 @@ fn main_command_and_batch_take_the_same_options() {
         "--chunk-frames <FRAMES>",
         "--lead-in <FRAMES>",
         "--gmr",
+        "--both-ways",
     ];
     for option in shared {
         assert!(main.contains_key(option), "main command lacks {option}: {main:?}");

@@ -241,6 +241,20 @@ pub struct ClipDiagnostics {
 }
 
 impl ClipDiagnostics {
+    /// Frames taken from the backward first pass ([`PlausibleOptions::both_ways`]) and the
+    /// stretches they form.
+    #[must_use]
+    pub fn from_backward(&self) -> (usize, usize) {
+        let frames = self.frames.iter().filter(|f| f.backward).count();
+        let starts = self
+            .frames
+            .iter()
+            .enumerate()
+            .filter(|&(t, f)| f.backward && (t == 0 || !self.frames[t - 1].backward))
+            .count();
+        (frames, starts)
+    }
+
     /// Per body: mean and 95th percentile of the position error (m) over the frames.
     #[must_use]
     pub fn position_error_stats(&self) -> Vec<(f64, f64)> {
@@ -669,6 +683,7 @@ impl<'a> Prepared<'a> {
         let mut frames = vec![FrameDiagnostics::default(); range.len()];
         for (k, f) in range.clone().enumerate().rev() {
             frames[k] = self.first_pass_frame(&mut solver, f, f + 1 == range.end)?;
+            frames[k].backward = true;
             reject_divergence(solver.qpos(), f)?;
             qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
         }

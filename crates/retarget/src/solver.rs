@@ -125,6 +125,9 @@ pub struct FrameDiagnostics {
     /// Steps whose constraints could not all hold together, so that some were relaxed
     /// (self-collision first, then joint speed); see [`Solver::add_constraint`].
     pub relaxed_steps: usize,
+    /// The frame comes from the backward first pass
+    /// ([`crate::PlausibleOptions::both_ways`]).
+    pub backward: bool,
 }
 
 /// Distance to a range end (rad or m) below which a joint counts as at its limit.
@@ -405,6 +408,7 @@ impl<'m> Solver<'m> {
             at_limit: self.at_limit(),
             qp_failures: self.qp_failures,
             relaxed_steps: self.relaxed_steps,
+            backward: false,
         })
     }
 
