@@ -597,15 +597,15 @@ pub fn plan(
             if let Some((edge, frames_off)) = edges[t] {
                 // (The tolerance: at 30 fps and 1/30 s, one frame is all the way up.)
                 let rise = smoothstep((frames_off as f64 / (options.lift_s * fps) + 1e-9).min(1.0));
-                if frames_off as f64 <= lift_frames {
+                let rising = frames_off as f64 <= lift_frames;
+                if rising {
                     // Rising (or coming down): the point the sole last touched the floor with
                     // (or first touches it with) stays where it is, and the foot turns about
                     // it to the orientation the blend gives it.
                     pose = lifted_over(foot, &pose, &targets[edge * slots + foot.slot]);
                     changed = true;
                 }
-                let margin =
-                    if frames_off as f64 <= lift_frames { options.lift_margin } else { 0.0 };
+                let margin = if rising { options.lift_margin } else { 0.0 };
                 let height = (options.swing_clearance + margin) * rise;
                 if height > 0.0 {
                     swing_floor[t][side] = Some(height);

@@ -1201,9 +1201,9 @@ fn diverged(qpos: &[f64]) -> bool {
     qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
 }
 
-/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
-/// Joints of two solutions closer than this (rad, m) in every hinge and slide coordinate
-/// and the free root's position: the same branch, where one pass may hand over to the other.
+/// Two solutions closer than this in every hinge and slide coordinate and the free root's
+/// position (rad, m), and in the angle between each free or ball joint's quaternions (rad):
+/// the same branch, where one pass may hand over to the other.
 const PASSES_AGREE: f64 = 0.05;
 
 /// What [`splice_passes`] compares: every hinge and slide joint's coordinate and the free
@@ -1295,6 +1295,7 @@ fn splice_passes(
     switches
 }
 
+/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
 pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
     if diverged(qpos) {
         return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });
