@@ -81,6 +81,10 @@ class Motion:
         """The robot's standing leg length (m, or None) and the default solve's smoothing
         passes at 30 frames/s (more for legs under 0.55 m; 0 for GMR's solve)."""
     @property
+    def uncrossed(self) -> List[Tuple[int, int]]:
+        """Frames (first, last) of the human's crossed steps the robot could not stand in,
+        planned side by side and solved again (default solve; empty otherwise)."""
+    @property
     def backward(self) -> Tuple[int, int]:
         """Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise)
         and the stretches they form."""

@@ -492,6 +492,13 @@ impl Motion {
         (self.diag.leg_length, self.diag.smoothing_passes)
     }
 
+    /// Frames ``(first, last)`` of the crossed steps of the human's that the robot could not
+    /// stand in, planned uncrossed and solved again (default solve; empty otherwise).
+    #[getter]
+    fn uncrossed(&self) -> Vec<(usize, usize)> {
+        self.diag.uncrossed.iter().map(|r| (r.start, r.end - 1)).collect()
+    }
+
     /// Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise) and
     /// the stretches they form.
     #[getter]

@@ -104,3 +104,11 @@ def test_both_ways_takes_a_stuck_hip_from_the_backward_pass(shared):
         assert (frames > 0 and stretches > 0) == (mode == "both_ways"), motion.backward
     assert over["default"] > 100 and over["both_ways"] == 0, over
 
+
+def test_a_robot_that_cannot_stand_crossed_steps_beside(walk):
+    """The T1's legs are too thick for the LAFAN1 walk's crouched crossovers: those two steps
+    are planned side by side (as the main command says)."""
+    motion = retarget.Retargeter("booster_t1_29dof").retarget_bvh(walk)
+    assert motion.uncrossed == [(2990, 2996), (3292, 3300)], motion.uncrossed
+    assert retarget.Retargeter("unitree_g1").retarget_bvh(walk).uncrossed == []
+

@@ -204,6 +204,17 @@ fn print_summary(
             leg, diag.smoothing_passes
         );
     }
+    if !diag.uncrossed.is_empty() {
+        let list: Vec<String> =
+            diag.uncrossed.iter().map(|r| format!("{}-{}", r.start, r.end - 1)).collect();
+        let n = list.len();
+        println!(
+            "default solve: the robot could not stand in {n} crossed step{} of the human's \
+             (frames {}); planned uncrossed and solved again",
+            if n == 1 { "" } else { "s" },
+            list.join(", ")
+        );
+    }
     if both_ways {
         let (backward, stretches) = diag.from_backward();
         let plural = if stretches == 1 { "" } else { "es" };

@@ -162,6 +162,29 @@ fn both_ways_reports_what_it_took_from_the_backward_pass() {
     assert!(stderr(&out).contains("cannot be used with"), "{}", stderr(&out));
 }
 
+/// The main command says where the robot could not stand in the human's crossed steps
+/// (the T1 in the LAFAN1 walk's crouched crossovers), and the same with `--chunk-frames`.
+#[test]
+fn the_main_command_says_which_crossed_steps_it_uncrossed() {
+    let walk = repo("data/samples/lafan1_walk.bvh");
+    let dir = temp_dir("uncrossed");
+    let out_path = dir.join("walk.npz");
+    let args = ["--bvh", walk.to_str().unwrap(), "--robot", "booster_t1_29dof", "-o"];
+    for extra in [&[][..], &["--chunk-frames", "2000"][..]] {
+        let out = retarget(&[&args[..], &[out_path.to_str().unwrap()], extra].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = stdout(&out);
+        assert!(
+            text.lines().any(|l| l.starts_with(
+                "default solve: the robot could not stand in 2 \
+                 crossed steps of the human's (frames 2990-2996, 3292-3300); planned uncrossed \
+                 and solved again"
+            )),
+            "{text}"
+        );
+    }
+}
+
 #[test]
 fn main_command_and_batch_take_the_same_options() {
     let main = help_entries(&stdout(&retarget(&["--help"])));

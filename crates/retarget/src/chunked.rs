@@ -21,6 +21,7 @@ use rayon::prelude::*;
 use crate::config::IkConfig;
 use crate::motion::RobotMotion;
 use crate::pipeline::{ClipDiagnostics, Error, Prepared, RetargetOptions, Solved};
+use crate::solver::FrameDiagnostics;
 
 /// How to cut a clip: chunks of `frames` frames, each preceded by `lead_in` frames of warm-up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,14 +50,23 @@ pub fn retarget_motion_chunked(
     if chunk.frames == 0 {
         return Err(Error::InvalidOption("chunks need at least one frame".to_owned()));
     }
-    let prepared = Prepared::new(human, model, config, options)?;
+    let mut prepared = Prepared::new(human, model, config, options)?;
     let n = prepared.num_frames();
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
     let started = Instant::now();
-    let parts = starts
-        .par_iter()
-        .map(|&start| prepared.solve(start..(start + chunk.frames).min(n), chunk.lead_in))
-        .collect::<Result<Vec<Solved>, Error>>()?;
+    let solve = |prepared: &Prepared| {
+        starts
+            .par_iter()
+            .map(|&start| prepared.solve(start..(start + chunk.frames).min(n), chunk.lead_in))
+            .collect::<Result<Vec<Solved>, Error>>()
+    };
+    let mut parts = solve(&prepared)?;
+    let frames: Vec<FrameDiagnostics> =
+        parts.iter().flat_map(|part| part.frames.iter().cloned()).collect();
+    let solved: Vec<f64> = parts.iter().flat_map(|part| part.qpos.iter().copied()).collect();
+    if prepared.uncross_stuck(&solved, &frames) {
+        parts = solve(&prepared)?;
+    }
     let seconds = started.elapsed().as_secs_f64();
     let mut qpos = Vec::with_capacity(n * model.nq);
     let mut frames = Vec::with_capacity(n);

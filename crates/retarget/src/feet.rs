@@ -18,6 +18,9 @@
 //!    [`FootPlanOptions::pivot_turn`] (45°) is a **pivot**: the planted foot turns with the
 //!    source's yaw about its toe point (which stays on the anchor), as a foot turning on its
 //!    ball does, instead of holding the mean yaw and twisting the leg by half the turn.
+//!    Overlapping stance phases of the two feet are kept apart; where the left foot stands
+//!    to the right of the right one, they are a [`Crossing`], which the solve can ask to be
+//!    planned again side by side ([`plan_uncrossing`]) when the robot cannot stand in it.
 //! 3. **Blending**: for [`FootPlanOptions::blend_s`] before touch-down and after lift-off the
 //!    planted pose's offset from the free target (position and yaw, taken at the edge) fades
 //!    out along a smoothstep, and so does the weight, so the foot neither jumps onto its
@@ -30,8 +33,9 @@
 //!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames (at 30 fps,
 //!    one frame, all the way up). While it rises or comes down, the point of the sole it last
 //!    stood on (or first lands on) stays where it was (will be) on the floor, seen from
-//!    above, and the foot turns about it as the blend turns it: it lifts off before it
-//!    moves and moves before it comes down. A foot is then either on the floor and still, or
+//!    above, and the foot turns about it as the blend turns it (a foot standing flat, whose
+//!    corners are all on the floor, only as far as moves none of them more than 3 mm): it
+//!    lifts off before it moves and moves before it comes down. A foot is then either on the floor and still, or
 //!    clear of it. Without this, the swing foot skims the floor at the start and end of every
 //!    step, a few millimetres up and moving at a few dm/s; and while the first frame of a
 //!    swing at 30 fps still moved with the free target (eased), the sole's last contact point
@@ -473,6 +477,22 @@ pub struct FootPlan {
     /// Per frame and foot out of stance: the least height (m) above the floor the swing
     /// clearance asks of the sole's lowest point, where it asks any.
     pub swing_floor: Vec<[Option<f64>; 2]>,
+    /// Stance phases of the two feet that overlap in time with the left foot planted to the
+    /// right of the right one ([`Crossing`]), as planned (uncrossed ones included).
+    pub crossed: Vec<Crossing>,
+}
+
+/// Two stance phases, one per foot, that overlap in time with the feet crossed: the left
+/// foot's footprint centre is to the right of the right one's (across their mean heading).
+/// The human steps over like this in a crossover or a turn; a robot whose legs are too thick
+/// for it cannot stand there with both feet down (the T1 in the LAFAN1 walk's crouched
+/// crossover steps) and is uncrossed ([`plan_uncrossing`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Crossing {
+    /// First frames of the left and the right foot's stance phase (with the lead).
+    pub phases: (usize, usize),
+    /// The frames both are planted.
+    pub frames: Range<usize>,
 }
 
 /// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
@@ -483,6 +503,21 @@ pub fn plan(
     slots: usize,
     fps: f64,
     options: &FootPlanOptions,
+) -> FootPlan {
+    plan_uncrossing(feet, contacts, targets, slots, fps, options, &[])
+}
+
+/// [`plan`], with the crossed stance phases `uncross` (their [`Crossing::phases`]) moved
+/// apart sideways until they are no longer crossed and their soles are
+/// [`FootPlanOptions::sole_gap`] apart across their mean heading, half the way each.
+pub fn plan_uncrossing(
+    feet: &[Option<RobotFoot>; 2],
+    contacts: &FootContacts,
+    targets: &mut [Pose],
+    slots: usize,
+    fps: f64,
+    options: &FootPlanOptions,
+    uncross: &[(usize, usize)],
 ) -> FootPlan {
     let frames = targets.len().checked_div(slots).unwrap_or(0);
     let labels = [&contacts.left, &contacts.right];
@@ -542,8 +577,10 @@ pub fn plan(
         free_yaw[side] = free.iter().map(|p| foot.yaw(&quat(p))).collect();
         free_targets[side] = free;
     }
+    let mut crossed = Vec::new();
     if let [Some(left), Some(right)] = feet {
         separate(left, right, &mut anchors, options.sole_gap);
+        crossed = uncrossed(left, right, &mut anchors, options.sole_gap, uncross);
     }
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
@@ -625,7 +662,7 @@ pub fn plan(
             }
         }
     }
-    FootPlan { shift, weight, contact, swing_floor }
+    FootPlan { shift, weight, contact, swing_floor, crossed }
 }
 
 /// The part of a mean yaw difference (rad) between a foot's target and the foot its shin's
@@ -810,6 +847,61 @@ fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2]
             }
         }
     }
+}
+
+/// The crossed pairs of overlapping stance phases ([`Crossing`]), found after [`separate`];
+/// those listed in `uncross` are moved apart across their mean heading, half the way each,
+/// until the left footprint is `gap` to the left of the right one.
+fn uncrossed(
+    left: &RobotFoot,
+    right: &RobotFoot,
+    anchors: &mut [Vec<Planted>; 2],
+    gap: f64,
+    uncross: &[(usize, usize)],
+) -> Vec<Crossing> {
+    let mut out = Vec::new();
+    if left.corners.is_empty() || right.corners.is_empty() || gap.is_nan() {
+        return out;
+    }
+    let [lefts, rights] = anchors;
+    for (lr, lxy, lyaw) in lefts.iter_mut() {
+        for (rr, rxy, ryaw) in rights.iter_mut() {
+            let frames = lr.start.max(rr.start)..lr.end.min(rr.end);
+            if frames.is_empty() {
+                continue;
+            }
+            let yaw = (lyaw.sin() + ryaw.sin()).atan2(lyaw.cos() + ryaw.cos());
+            let across = Vector3::new(-yaw.sin(), yaw.cos(), 0.0);
+            // The footprints' extents across the heading: the left one's least, the right
+            // one's greatest.
+            let extent = |foot: &RobotFoot, xy: &Vector3<f64>, foot_yaw: f64| {
+                let flat = foot.flat(foot_yaw);
+                let at = |c: &Vector3<f64>| (Vector3::new(xy.x, xy.y, 0.0) + flat * c).dot(&across);
+                let (lo, hi) = foot
+                    .corners
+                    .iter()
+                    .map(at)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+                (lo, hi, (lo + hi) / 2.0)
+            };
+            let (l_lo, _, l_mid) = extent(left, lxy, *lyaw);
+            let (_, r_hi, r_mid) = extent(right, rxy, *ryaw);
+            if l_mid >= r_mid {
+                continue;
+            }
+            let phases = (lr.start, rr.start);
+            if uncross.contains(&phases) {
+                // Half the way each. (Moving only the foot that stepped into the crossed stance
+                // set the T1's feet wide apart in its crouch: its pelvis then dropped more than
+                // 5 cm below its target in 35 frames of the LAFAN1 walk, against 2.)
+                let short = gap + r_hi - l_lo;
+                *lxy += across * (short / 2.0);
+                *rxy -= across * (short / 2.0);
+            }
+            out.push(Crossing { phases, frames });
+        }
+    }
+    out
 }
 
 /// An offset of a foot target (position and yaw), accumulated with weights, with the free
@@ -1121,6 +1213,34 @@ mod tests {
         let before = anchors.clone();
         separate(&foot, &foot, &mut anchors, 0.02);
         assert_eq!(anchors, before);
+    }
+
+    #[test]
+    fn crossed_stances_are_found_and_uncrossed_on_request() {
+        let foot = box_foot();
+        // Facing +x, the left foot planted 4 cm to the right of the right one (10 cm wide
+        // soles), 25 cm behind it, over frames 0..10 and 5..15; a later pair is not crossed.
+        let mut anchors = [
+            vec![
+                (0..10, Vector3::new(0.0, -0.02, 0.0), 0.0),
+                (20..30, Vector3::new(1.0, 0.1, 0.0), 0.0),
+            ],
+            vec![
+                (5..15, Vector3::new(0.25, 0.02, 0.0), 0.0),
+                (25..35, Vector3::new(1.2, -0.1, 0.0), 0.0),
+            ],
+        ];
+        let found = uncrossed(&foot, &foot, &mut anchors.clone(), 0.03, &[]);
+        assert_eq!(found, vec![Crossing { phases: (0, 5), frames: 5..10 }]);
+        let again = uncrossed(&foot, &foot, &mut anchors, 0.03, &[(0, 5)]);
+        assert_eq!(again, found);
+        // Each moves half of 4 + 10 + 3 cm sideways: the left sole's right edge is 3 cm to
+        // the left of the right sole's left edge.
+        let (left, right) = (anchors[0][0].1, anchors[1][0].1);
+        assert!((left.y - 0.065).abs() < 1e-12, "{left}");
+        assert!((right.y + 0.065).abs() < 1e-12, "{right}");
+        assert!((left.x, right.x) == (0.0, 0.25));
+        assert_eq!(anchors[0][1].1, Vector3::new(1.0, 0.1, 0.0));
     }
 
     /// One step of a flat box foot (sole 2 cm below its origin) at `fps`: planted for the

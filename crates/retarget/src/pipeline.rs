@@ -43,6 +43,23 @@ impl Default for SolveMode {
     }
 }
 
+/// A planted foot this far (m) from its target in a crossed stance is stuck there
+/// ([`PlausibleOptions::uncross_stuck`]). Where the T1 could not stand crossed, its planted
+/// feet were 5–13 cm off.
+pub const UNCROSS_STUCK: f64 = 0.03;
+
+/// The two legs touch where geoms of theirs are closer than this (m)
+/// ([`PlausibleOptions::uncross_stuck`]).
+pub const LEGS_TOUCH: f64 = 0.005;
+
+/// A robot stuck in a crossed stance has its pelvis at least this far (m) below its target
+/// ([`PlausibleOptions::uncross_stuck`]): legs in each other's way are shorter. (The T1 on
+/// the LAFAN1 walk: 6–19 cm. The H1, whose feet are off their targets in crossed stances
+/// too, as elsewhere, for want of an ankle roll, stands 5–13 cm above its target there,
+/// and uncrossing them widened stances its feet could not stand flat in: sliding 6.9 →
+/// 7.7 %.)
+pub const UNCROSS_SINK: f64 = 0.03;
+
 /// Tunables of [`SolveMode::Plausible`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlausibleOptions {
@@ -111,6 +128,16 @@ pub struct PlausibleOptions {
     /// the kick, and the backward pass, which reaches the kick from the normal stance, never
     /// does. Costs a second first pass, run on a second thread of rayon's pool.
     pub both_ways: bool,
+    /// Where the robot could not hold its feet in a crossed stance ([`crate::feet::Crossing`]:
+    /// a planted foot [`UNCROSS_STUCK`] or further from its target in a frame both feet are
+    /// down), plan those steps again uncrossed and solve the clip again. The human crosses
+    /// over in a crouch on the LAFAN1 walk (frames 3240–3300, the right foot landing 11 cm to
+    /// the left of the left one); the T1's legs are too thick for it: with the soles held
+    /// crossed, its self-collision rows lifted both planted feet 5–13 cm and dropped its pelvis
+    /// 13–20 cm below its target. Uncrossing every crossed stance instead kept the T1's feet
+    /// down but tripled the foot error of every robot (the G1's walk 14 → 49 mm), whose legs
+    /// cross there without trouble. Costs a second solve of a clip where it finds any.
+    pub uncross_stuck: bool,
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
     pub repair_steps: usize,
@@ -157,6 +184,7 @@ impl Default for PlausibleOptions {
             root_position_weight_cap: 20.0,
             pelvis_offset_range: [0.005, 0.015],
             both_ways: false,
+            uncross_stuck: true,
             repair_weight: 1000.0,
             repair_steps: 1,
             max_extra_steps: 10,
@@ -175,6 +203,7 @@ impl PlausibleOptions {
             planting: Planting::Off,
             smoothing_passes: 0,
             both_ways: false,
+            uncross_stuck: false,
             ..PlausibleOptions::default()
         }
     }
@@ -238,6 +267,9 @@ pub struct ClipDiagnostics {
     /// passes at 30 frames/s it gave ([`PlausibleOptions::smoothing_leg`]; default solve).
     pub leg_length: Option<f64>,
     pub smoothing_passes: usize,
+    /// Frames of the crossed stances planned again uncrossed
+    /// ([`PlausibleOptions::uncross_stuck`]), in order.
+    pub uncrossed: Vec<Range<usize>>,
 }
 
 impl ClipDiagnostics {
@@ -327,9 +359,12 @@ pub fn retarget_motion(
     config: &IkConfig,
     options: &RetargetOptions,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-    let prepared = Prepared::new(human, model, config, options)?;
+    let mut prepared = Prepared::new(human, model, config, options)?;
     let start = Instant::now();
-    let solved = prepared.solve(0..human.num_frames, 0)?;
+    let mut solved = prepared.solve(0..human.num_frames, 0)?;
+    if prepared.uncross_stuck(&solved.qpos, &solved.frames) {
+        solved = prepared.solve(0..human.num_frames, 0)?;
+    }
     Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
 }
 
@@ -348,6 +383,10 @@ pub(crate) struct Prepared<'a> {
     contacts: Option<FootContacts>,
     /// Foot bodies and per-frame weight factors (default mode).
     plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
+    /// The targets before the foot plan rewrote them (default mode, planted feet), to plan
+    /// again from ([`Prepared::uncross_stuck`]), and the stance overlaps uncrossed.
+    unplanned: Option<Vec<Pose>>,
+    uncrossed: Vec<Range<usize>>,
     fps: f64,
     height: f64,
     /// Target slot of the human root.
@@ -405,6 +444,8 @@ impl<'a> Prepared<'a> {
             targets,
             contacts: None,
             plan: None,
+            unplanned: None,
+            uncrossed: Vec::new(),
             fps: human.fps,
             height,
             root_target: map.root,
@@ -448,6 +489,9 @@ impl<'a> Prepared<'a> {
     /// constraints apply).
     fn plan_feet(&mut self, options: &PlausibleOptions, feet: [Option<RobotFoot>; 2]) {
         let Some(contacts) = &self.contacts else { return };
+        if options.uncross_stuck {
+            self.unplanned = Some(self.targets.clone());
+        }
         let plan = crate::feet::plan(
             &feet,
             contacts,
@@ -457,6 +501,107 @@ impl<'a> Prepared<'a> {
             &options.feet,
         );
         self.plan = Some((feet, plan));
+    }
+
+    /// [`PlausibleOptions::uncross_stuck`]: plans the feet again, with the crossed stance
+    /// phases uncrossed in which `frames` (the clip's solved frames) have a planted foot
+    /// [`UNCROSS_STUCK`] or further from its target. Whether it planned again (then the clip
+    /// is to be solved again; its weights stay as they are).
+    pub(crate) fn uncross_stuck(&mut self, qpos: &[f64], frames: &[FrameDiagnostics]) -> bool {
+        let (SolveMode::Plausible(options), Some(unplanned), Some((feet, plan)), Some(contacts)) =
+            (&self.options.mode, &self.unplanned, &self.plan, &self.contacts)
+        else {
+            return false;
+        };
+        let [Some(left), Some(right)] = feet else { return false };
+        if plan.crossed.is_empty() {
+            return false;
+        }
+        let model = self.model;
+        // The feet's places among the solver's tracked bodies, whose errors `frames` hold.
+        let tracked: Vec<usize> = [left, right]
+            .iter()
+            .filter_map(|foot| self.tracked.iter().position(|&(_, slot)| slot == foot.slot))
+            .collect();
+        // The geom pairs between the two legs: each leg is the subtree of the foot's highest
+        // ancestor that is not also the other foot's.
+        let ancestors = |b: usize| {
+            std::iter::successors(Some(b), |&b| (b != 0).then(|| model.bodies[b].parent))
+                .collect::<Vec<usize>>()
+        };
+        let (up_left, up_right) = (ancestors(left.body), ancestors(right.body));
+        let top = |up: &[usize], other: &[usize]| {
+            up.iter().take_while(|b| !other.contains(b)).last().copied()
+        };
+        let (Some(top_left), Some(top_right)) =
+            (top(&up_left, &up_right), top(&up_right, &up_left))
+        else {
+            return false;
+        };
+        let leg_of = |g: usize| {
+            let up = ancestors(model.geoms[g].body);
+            if up.contains(&top_left) {
+                Some(0)
+            } else if up.contains(&top_right) {
+                Some(1)
+            } else {
+                None
+            }
+        };
+        let between: Vec<[usize; 2]> = model
+            .self_collision_pairs()
+            .pairs
+            .into_iter()
+            .filter(|&[a, b]| matches!((leg_of(a), leg_of(b)), (Some(x), Some(y)) if x != y))
+            .collect();
+        // The body that follows the human root's target.
+        let Some(root) =
+            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
+        else {
+            return false;
+        };
+        let nq = model.nq;
+        let mut data = mjcf::Data::new(model);
+        // A frame is stuck where a planted foot is far from its target, the legs touch and the
+        // pelvis sinks below its target.
+        let mut stuck = |t: usize| {
+            let far = frames.get(t).is_some_and(|f| {
+                tracked.iter().any(|&k| f.pos_error.get(k).is_some_and(|e| *e >= UNCROSS_STUCK))
+            });
+            let Some(q) = qpos.get(t * nq..(t + 1) * nq) else { return false };
+            if !far {
+                return false;
+            }
+            model.kinematics(q, &mut data);
+            let sunk = self.frame_targets(t)[self.root_target].pos.z - data.xpos[root].z;
+            sunk >= UNCROSS_SINK
+                && between.iter().any(|&[a, b]| {
+                    mjcf::geom_distance(model, &data, a, b, LEGS_TOUCH)
+                        .is_some_and(|p| p.distance < LEGS_TOUCH)
+                })
+        };
+        let (phases, overlaps): (Vec<(usize, usize)>, Vec<Range<usize>>) = plan
+            .crossed
+            .iter()
+            .filter(|c| c.frames.clone().any(&mut stuck))
+            .map(|c| (c.phases, c.frames.clone()))
+            .unzip();
+        if phases.is_empty() {
+            return false;
+        }
+        let feet = [Some(left.clone()), Some(right.clone())];
+        let mut targets = unplanned.clone();
+        let plan = crate::feet::plan_uncrossing(
+            &feet,
+            contacts,
+            &mut targets,
+            self.slots,
+            self.fps,
+            &options.feet,
+            &phases,
+        );
+        (self.targets, self.plan, self.uncrossed) = (targets, Some((feet, plan)), overlaps);
+        true
     }
 
     /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
@@ -811,6 +956,7 @@ impl<'a> Prepared<'a> {
             reweigh_share: self.reweigh_share,
             leg_length: self.leg_length,
             smoothing_passes: self.smoothing_passes,
+            uncrossed: self.uncrossed.clone(),
         };
         (motion, diag)
     }

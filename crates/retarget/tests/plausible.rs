@@ -383,3 +383,62 @@ fn a_limb_stuck_in_another_branch_is_taken_from_the_backward_pass() {
     assert_eq!(both.ground_penetration.frames, 0);
     assert_eq!(both.joint_speed.as_ref().unwrap().violations, 0);
 }
+
+/// The LAFAN1 walk crosses over in a crouch (near frames 2990 and 3292 of the shared take, the
+/// right foot landing 11 cm to the left of the left one). The T1's legs are too thick to stand
+/// like that: held crossed, its planted feet came off their targets and its pelvis sank 9–12
+/// cm below its target, lifted by legs in each other's way. Planned again uncrossed
+/// ([`retarget::PlausibleOptions::uncross_stuck`]), they stay.
+#[test]
+fn a_robot_that_cannot_stand_crossed_steps_beside_instead() {
+    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let (full, fk_report) =
+        fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
+    let human = slice(&full, 2900..3400);
+    let robot = |uncross_stuck| {
+        let mode = retarget::SolveMode::Plausible(retarget::PlausibleOptions {
+            uncross_stuck,
+            ..Default::default()
+        });
+        retarget::Retargeter::new("booster_t1_29dof")
+            .unwrap()
+            .with_mode(mode)
+            .with_human_height(Some(fk_report.height))
+    };
+    let (uncrossed, diag) = robot(true).retarget(&human).unwrap();
+    let (crossed, held) = robot(false).retarget(&human).unwrap();
+    assert!(held.uncrossed.is_empty());
+    assert_eq!(diag.uncrossed.len(), 2, "{:?}", diag.uncrossed);
+    let r = robot(true);
+    let model = r.model();
+    // Over the crossed stances: how far the pelvis sinks below its target, and the largest
+    // error of a foot (they are planted).
+    let worst = |motion: &retarget::RobotMotion, frames: &retarget::ClipDiagnostics| {
+        let targets = motion.targets.as_ref().unwrap();
+        let k = |name: &str| targets.body_names.iter().position(|b| b == name).unwrap();
+        let (waist, feet) = (k("Waist"), [k("left_foot_link"), k("right_foot_link")]);
+        let body = |name: &str| model.bodies.iter().position(|b| b.name == name).unwrap();
+        let waist_body = body("Waist");
+        let mut data = mjcf::Data::new(model);
+        let (mut sink, mut foot) = (0.0_f64, 0.0_f64);
+        let n = targets.body_names.len();
+        for range in &diag.uncrossed {
+            for t in range.clone() {
+                model.kinematics(&motion.qpos[t * model.nq..(t + 1) * model.nq], &mut data);
+                sink = sink.max(targets.pos[t * n + waist].z - data.xpos[waist_body].z);
+                for f in feet {
+                    foot = foot.max(frames.frames[t].pos_error[f]);
+                }
+            }
+        }
+        (sink, foot)
+    };
+    let (sink, foot) = worst(&uncrossed, &diag);
+    let (sink_crossed, foot_crossed) = worst(&crossed, &held);
+    // (Measured: 0.11 and 0.033 m held crossed; 0 and 0.004 m uncrossed.)
+    assert!(sink_crossed > 0.06, "held crossed, the pelvis sinks {sink_crossed} m");
+    assert!(sink < 0.03, "uncrossed, the pelvis sinks {sink} m");
+    assert!(foot < 0.5 * foot_crossed, "a planted foot {foot} m off, against {foot_crossed} m");
+}
