@@ -21,7 +21,6 @@ use rayon::prelude::*;
 use crate::config::IkConfig;
 use crate::motion::RobotMotion;
 use crate::pipeline::{ClipDiagnostics, Error, Prepared, RetargetOptions, Solved};
-use crate::solver::FrameDiagnostics;
 
 /// How to cut a clip: chunks of `frames` frames, each preceded by `lead_in` frames of warm-up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,30 +53,23 @@ pub fn retarget_motion_chunked(
     let n = prepared.num_frames();
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
     let started = Instant::now();
-    let solve = |prepared: &Prepared| {
-        starts
-            .par_iter()
-            .map(|&start| prepared.solve(start..(start + chunk.frames).min(n), chunk.lead_in))
-            .collect::<Result<Vec<Solved>, Error>>()
-    };
-    let mut parts = solve(&prepared)?;
-    let frames: Vec<FrameDiagnostics> =
-        parts.iter().flat_map(|part| part.frames.iter().cloned()).collect();
-    let solved: Vec<f64> = parts.iter().flat_map(|part| part.qpos.iter().copied()).collect();
-    if prepared.uncross_stuck(&solved, &frames) {
-        parts = solve(&prepared)?;
-    }
-    let seconds = started.elapsed().as_secs_f64();
-    let mut qpos = Vec::with_capacity(n * model.nq);
-    let mut frames = Vec::with_capacity(n);
+    let parts = starts
+        .par_iter()
+        .map(|&start| prepared.solve(start..(start + chunk.frames).min(n), chunk.lead_in))
+        .collect::<Result<Vec<Solved>, Error>>()?;
+    let mut solved =
+        Solved { qpos: Vec::with_capacity(n * model.nq), frames: Vec::with_capacity(n) };
     for mut part in parts {
+        let qpos = &solved.qpos;
         if let Some(last) = qpos.len().checked_sub(model.nq).and_then(|at| qpos.get(at..)) {
             continue_quaternions(model, last, &mut part.qpos);
         }
-        qpos.extend(part.qpos);
-        frames.extend(part.frames);
+        solved.qpos.extend(part.qpos);
+        solved.frames.extend(part.frames);
     }
-    Ok(prepared.finish(qpos, frames, seconds))
+    prepared.resolve_uncrossed(&mut solved)?;
+    let seconds = started.elapsed().as_secs_f64();
+    Ok(prepared.finish(solved.qpos, solved.frames, seconds))
 }
 
 /// Negates a chunk's quaternions (free and ball joints; `qpos`: its frames) where its first
@@ -85,7 +77,7 @@ pub fn retarget_motion_chunked(
 /// so that the clip's quaternions stay continuous across the seam as they do in the serial
 /// solve. Each chunk starts from `qpos0` and may settle on either sign: the LAFAN1 walk in
 /// chunks of 600 frames had the root's quaternion flip sign at 5 of its 11 seams.
-fn continue_quaternions(model: &Model, last: &[f64], qpos: &mut [f64]) {
+pub(crate) fn continue_quaternions(model: &Model, last: &[f64], qpos: &mut [f64]) {
     let nq = model.nq.max(1);
     for joint in &model.joints {
         let Some(at) = joint.quat_adr() else { continue };

@@ -48,6 +48,11 @@ impl Default for SolveMode {
 /// feet were 5–13 cm off.
 pub const UNCROSS_STUCK: f64 = 0.03;
 
+/// Frames solved again either side of the frames whose targets an uncrossing changed
+/// (`Prepared::resolve_uncrossed`), and the lead-in before them (as a chunk's).
+pub const RESOLVE_MARGIN: usize = 30;
+pub const RESOLVE_LEAD_IN: usize = 60;
+
 /// The two legs touch where geoms of theirs are closer than this (m)
 /// ([`PlausibleOptions::uncross_stuck`]).
 pub const LEGS_TOUCH: f64 = 0.005;
@@ -136,7 +141,9 @@ pub struct PlausibleOptions {
     /// crossed, its self-collision rows lifted both planted feet 5–13 cm and dropped its pelvis
     /// 13–20 cm below its target. Uncrossing every crossed stance instead kept the T1's feet
     /// down but tripled the foot error of every robot (the G1's walk 14 → 49 mm), whose legs
-    /// cross there without trouble. Costs a second solve of a clip where it finds any.
+    /// cross there without trouble. Costs solving again the frames whose targets that
+    /// changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps, 504 frames
+    /// of 7,184 with the margins and lead-in).
     pub uncross_stuck: bool,
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
@@ -362,9 +369,7 @@ pub fn retarget_motion(
     let mut prepared = Prepared::new(human, model, config, options)?;
     let start = Instant::now();
     let mut solved = prepared.solve(0..human.num_frames, 0)?;
-    if prepared.uncross_stuck(&solved.qpos, &solved.frames) {
-        solved = prepared.solve(0..human.num_frames, 0)?;
-    }
+    prepared.resolve_uncrossed(&mut solved)?;
     Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
 }
 
@@ -503,19 +508,50 @@ impl<'a> Prepared<'a> {
         self.plan = Some((feet, plan));
     }
 
+    /// [`PlausibleOptions::uncross_stuck`] on the whole clip's solved frames (`solved`): plans
+    /// the feet again with the stuck crossed stances uncrossed ([`Prepared::uncross_stuck`])
+    /// and solves again the frames whose targets that changed, with
+    /// [`RESOLVE_MARGIN`] frames either side and a lead-in of [`RESOLVE_LEAD_IN`], as a chunk
+    /// is solved ([`crate::chunked`]); the rest of the clip is kept.
+    pub(crate) fn resolve_uncrossed(&mut self, solved: &mut Solved) -> Result<(), Error> {
+        let Some(changed) = self.uncross_stuck(&solved.qpos, &solved.frames) else {
+            return Ok(());
+        };
+        let nq = self.model.nq;
+        let n = solved.frames.len();
+        let range =
+            changed.start.saturating_sub(RESOLVE_MARGIN)..(changed.end + RESOLVE_MARGIN).min(n);
+        let mut part = self.solve(range.clone(), RESOLVE_LEAD_IN)?;
+        if let Some(before) = range.start.checked_sub(1) {
+            crate::chunked::continue_quaternions(
+                self.model,
+                &solved.qpos[before * nq..range.start * nq],
+                &mut part.qpos,
+            );
+        }
+        solved.qpos.splice(range.start * nq..range.end * nq, part.qpos);
+        solved.frames.splice(range.clone(), part.frames);
+        if range.end < n {
+            let (head, tail) = solved.qpos.split_at_mut(range.end * nq);
+            crate::chunked::continue_quaternions(self.model, &head[head.len() - nq..], tail);
+        }
+        Ok(())
+    }
+
     /// [`PlausibleOptions::uncross_stuck`]: plans the feet again, with the crossed stance
-    /// phases uncrossed in which `frames` (the clip's solved frames) have a planted foot
-    /// [`UNCROSS_STUCK`] or further from its target. Whether it planned again (then the clip
-    /// is to be solved again; its weights stay as they are).
-    pub(crate) fn uncross_stuck(&mut self, qpos: &[f64], frames: &[FrameDiagnostics]) -> bool {
+    /// phases uncrossed in which the clip's solved frames (`qpos`, `frames`) have a planted
+    /// foot [`UNCROSS_STUCK`] or further from its target, the legs touching and the pelvis
+    /// sunk. The frames whose targets changed, if it planned again (its weights stay as they
+    /// are).
+    fn uncross_stuck(&mut self, qpos: &[f64], frames: &[FrameDiagnostics]) -> Option<Range<usize>> {
         let (SolveMode::Plausible(options), Some(unplanned), Some((feet, plan)), Some(contacts)) =
             (&self.options.mode, &self.unplanned, &self.plan, &self.contacts)
         else {
-            return false;
+            return None;
         };
-        let [Some(left), Some(right)] = feet else { return false };
+        let [Some(left), Some(right)] = feet else { return None };
         if plan.crossed.is_empty() {
-            return false;
+            return None;
         }
         let model = self.model;
         // The feet's places among the solver's tracked bodies, whose errors `frames` hold.
@@ -536,7 +572,7 @@ impl<'a> Prepared<'a> {
         let (Some(top_left), Some(top_right)) =
             (top(&up_left, &up_right), top(&up_right, &up_left))
         else {
-            return false;
+            return None;
         };
         let leg_of = |g: usize| {
             let up = ancestors(model.geoms[g].body);
@@ -555,11 +591,8 @@ impl<'a> Prepared<'a> {
             .filter(|&[a, b]| matches!((leg_of(a), leg_of(b)), (Some(x), Some(y)) if x != y))
             .collect();
         // The body that follows the human root's target.
-        let Some(root) =
-            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
-        else {
-            return false;
-        };
+        let root =
+            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)?;
         let nq = model.nq;
         let mut data = mjcf::Data::new(model);
         // A frame is stuck where a planted foot is far from its target, the legs touch and the
@@ -587,7 +620,7 @@ impl<'a> Prepared<'a> {
             .map(|c| (c.phases, c.frames.clone()))
             .unzip();
         if phases.is_empty() {
-            return false;
+            return None;
         }
         let feet = [Some(left.clone()), Some(right.clone())];
         let mut targets = unplanned.clone();
@@ -600,8 +633,15 @@ impl<'a> Prepared<'a> {
             &options.feet,
             &phases,
         );
+        let slots = self.slots.max(1);
+        let differs = |t: &usize| {
+            targets[t * slots..(t + 1) * slots] != self.targets[t * slots..(t + 1) * slots]
+        };
+        let frames_n = self.num_frames();
+        let first = (0..frames_n).find(differs)?;
+        let last = (0..frames_n).rev().find(differs)?;
         (self.targets, self.plan, self.uncrossed) = (targets, Some((feet, plan)), overlaps);
-        true
+        Some(first..last + 1)
     }
 
     /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
