@@ -45,7 +45,7 @@ impl Default for SolveMode {
 
 /// A planted foot this far (m) from its target in a crossed stance is stuck there
 /// ([`PlausibleOptions::uncross_stuck`]). Where the T1 could not stand crossed, its planted
-/// feet were 5–13 cm off.
+/// feet were up to 10 cm off.
 pub const UNCROSS_STUCK: f64 = 0.03;
 
 /// Frames solved again either side of the frames whose targets an uncrossing changed
@@ -133,17 +133,18 @@ pub struct PlausibleOptions {
     /// the kick, and the backward pass, which reaches the kick from the normal stance, never
     /// does. Costs a second first pass, run on a second thread of rayon's pool.
     pub both_ways: bool,
-    /// Where the robot could not hold its feet in a crossed stance ([`crate::feet::Crossing`]:
-    /// a planted foot [`UNCROSS_STUCK`] or further from its target in a frame both feet are
-    /// down), plan those steps again uncrossed and solve the clip again. The human crosses
-    /// over in a crouch on the LAFAN1 walk (frames 3240–3300, the right foot landing 11 cm to
-    /// the left of the left one); the T1's legs are too thick for it: with the soles held
-    /// crossed, its self-collision rows lifted both planted feet 5–13 cm and dropped its pelvis
-    /// 13–20 cm below its target. Uncrossing every crossed stance instead kept the T1's feet
-    /// down but tripled the foot error of every robot (the G1's walk 14 → 49 mm), whose legs
-    /// cross there without trouble. Costs solving again the frames whose targets that
-    /// changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps, 504 frames
-    /// of 7,184 with the margins and lead-in).
+    /// Where the robot could not stand in a crossed stance ([`crate::feet::Crossing`]: in a
+    /// frame both feet are down, a planted foot [`UNCROSS_STUCK`] or further from its target,
+    /// the legs within [`LEGS_TOUCH`] of each other and the pelvis [`UNCROSS_SINK`] or more
+    /// below its target), plan those steps again side by side and solve their frames again.
+    /// The human crosses over in a crouch on the LAFAN1 walk (near frames 2990, 3240 and 3300,
+    /// the right foot landing 11 cm to the left of the left one); the T1's legs are too thick
+    /// for it: held crossed, its self-collision rows lifted its planted feet up to 10 cm and
+    /// sank its pelvis up to 19 cm below its target. Uncrossing every crossed stance instead
+    /// kept the T1's feet down but tripled the foot error of every robot (the G1's walk 14 →
+    /// 49 mm), whose legs cross there without trouble. Costs solving again the frames whose
+    /// targets that changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps,
+    /// 504 frames of 7,184 with the margins and lead-in; 5 % more time).
     pub uncross_stuck: bool,
     /// [`Solver::repair_frame`]'s weight and steps.
     pub repair_weight: f64,
