@@ -483,7 +483,8 @@ pub struct FootPlan {
 }
 
 /// Two stance phases, one per foot, that overlap in time with the feet crossed: the left
-/// foot's footprint centre is to the right of the right one's (across their mean heading).
+/// foot's footprint centre is to the right of the right one's (across the robot's heading,
+/// [`plan_uncrossing`]).
 /// The human steps over like this in a crossover or a turn; a robot whose legs are too thick
 /// for it cannot stand there with both feet down (the T1 in the LAFAN1 walk's crouched
 /// crossover steps) and is uncrossed ([`plan_uncrossing`]).
@@ -504,12 +505,23 @@ pub fn plan(
     fps: f64,
     options: &FootPlanOptions,
 ) -> FootPlan {
-    plan_uncrossing(feet, contacts, targets, slots, fps, options, &[])
+    plan_uncrossing(feet, contacts, targets, slots, fps, options, &Uncrossing::default())
 }
 
-/// [`plan`], with the crossed stance phases `uncross` (their [`Crossing::phases`]) moved
-/// apart sideways until they are no longer crossed and their soles are
-/// [`FootPlanOptions::sole_gap`] apart across their mean heading, half the way each.
+/// Which crossed stances [`plan_uncrossing`] uncrosses, and across what.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Uncrossing<'a> {
+    /// The [`Crossing::phases`] to move apart.
+    pub uncross: &'a [(usize, usize)],
+    /// Per frame, the yaw (rad) the robot's pelvis is to face; empty: the two feet's mean
+    /// yaw.
+    pub heading: &'a [f64],
+}
+
+/// [`plan`], with the crossed stance phases `crossings.uncross` moved apart sideways until
+/// they are no longer crossed and their soles are [`FootPlanOptions::sole_gap`] apart, half
+/// the way each. Crossed and apart are across the robot's heading
+/// ([`Uncrossing::heading`]).
 pub fn plan_uncrossing(
     feet: &[Option<RobotFoot>; 2],
     contacts: &FootContacts,
@@ -517,8 +529,9 @@ pub fn plan_uncrossing(
     slots: usize,
     fps: f64,
     options: &FootPlanOptions,
-    uncross: &[(usize, usize)],
+    crossings: &Uncrossing<'_>,
 ) -> FootPlan {
+    let Uncrossing { uncross, heading } = *crossings;
     let frames = targets.len().checked_div(slots).unwrap_or(0);
     let labels = [&contacts.left, &contacts.right];
     let shift = floor_shift(feet, &labels, targets, slots, options.clearance);
@@ -580,7 +593,7 @@ pub fn plan_uncrossing(
     let mut crossed = Vec::new();
     if let [Some(left), Some(right)] = feet {
         separate(left, right, &mut anchors, options.sole_gap);
-        crossed = uncrossed(left, right, &mut anchors, options.sole_gap, uncross);
+        crossed = uncrossed(left, right, &mut anchors, options.sole_gap, uncross, heading);
     }
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
@@ -850,7 +863,7 @@ fn separate(left: &RobotFoot, right: &RobotFoot, anchors: &mut [Vec<Planted>; 2]
 }
 
 /// The crossed pairs of overlapping stance phases ([`Crossing`]), found after [`separate`];
-/// those listed in `uncross` are moved apart across their mean heading, half the way each,
+/// those listed in `uncross` are moved apart across the heading, half the way each,
 /// until the left footprint is `gap` to the left of the right one.
 fn uncrossed(
     left: &RobotFoot,
@@ -858,6 +871,7 @@ fn uncrossed(
     anchors: &mut [Vec<Planted>; 2],
     gap: f64,
     uncross: &[(usize, usize)],
+    heading: &[f64],
 ) -> Vec<Crossing> {
     let mut out = Vec::new();
     if left.corners.is_empty() || right.corners.is_empty() || gap.is_nan() {
@@ -870,7 +884,17 @@ fn uncrossed(
             if frames.is_empty() {
                 continue;
             }
-            let yaw = (lyaw.sin() + ryaw.sin()).atan2(lyaw.cos() + ryaw.cos());
+            // Across the pelvis's heading over the overlap (the legs hang from it; a foot
+            // pivoting in its stance turns the feet's mean heading away from it), else the
+            // feet's mean heading. (On the T1's LAFAN1 walk with the derived config, 4 stuck
+            // crossings against 5 by the feet's heading, foot error 26.6 → 26.0 mm.)
+            let yaw = match heading.get(frames.clone()) {
+                Some(h) if !h.is_empty() => {
+                    let (s, c) = h.iter().fold((0.0, 0.0), |(s, c), y| (s + y.sin(), c + y.cos()));
+                    s.atan2(c)
+                }
+                _ => (lyaw.sin() + ryaw.sin()).atan2(lyaw.cos() + ryaw.cos()),
+            };
             let across = Vector3::new(-yaw.sin(), yaw.cos(), 0.0);
             // The footprints' extents across the heading: the left one's least, the right
             // one's greatest.
@@ -1230,9 +1254,9 @@ mod tests {
                 (25..35, Vector3::new(1.2, -0.1, 0.0), 0.0),
             ],
         ];
-        let found = uncrossed(&foot, &foot, &mut anchors.clone(), 0.03, &[]);
+        let found = uncrossed(&foot, &foot, &mut anchors.clone(), 0.03, &[], &[]);
         assert_eq!(found, vec![Crossing { phases: (0, 5), frames: 5..10 }]);
-        let again = uncrossed(&foot, &foot, &mut anchors, 0.03, &[(0, 5)]);
+        let again = uncrossed(&foot, &foot, &mut anchors, 0.03, &[(0, 5)], &[]);
         assert_eq!(again, found);
         // Each moves half of 4 + 10 + 3 cm sideways: the left sole's right edge is 3 cm to
         // the left of the right sole's left edge.

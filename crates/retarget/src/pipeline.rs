@@ -498,15 +498,41 @@ impl<'a> Prepared<'a> {
         if options.uncross_stuck {
             self.unplanned = Some(self.targets.clone());
         }
-        let plan = crate::feet::plan(
+        let heading = self.heading();
+        let plan = crate::feet::plan_uncrossing(
             &feet,
             contacts,
             &mut self.targets,
             self.slots,
             self.fps,
             &options.feet,
+            &crate::feet::Uncrossing { uncross: &[], heading: &heading },
         );
         self.plan = Some((feet, plan));
+    }
+
+    /// Per frame, the yaw (rad) the robot's pelvis is to face: the root target's turn of the
+    /// body's forward direction (world +x at `qpos0`, as for the feet). Empty when no task
+    /// follows the root target.
+    fn heading(&self) -> Vec<f64> {
+        let Some(body) =
+            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
+        else {
+            return Vec::new();
+        };
+        let mut data = mjcf::Data::new(self.model);
+        self.model.kinematics(&self.model.qpos0, &mut data);
+        let forward = data.xquat[body].inverse() * Vector3::x();
+        (0..self.num_frames())
+            .map(|t| {
+                let p = &self.frame_targets(t)[self.root_target];
+                let q = UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+                    p.quat[0], p.quat[1], p.quat[2], p.quat[3],
+                ));
+                let f = q * forward;
+                f.y.atan2(f.x)
+            })
+            .collect()
     }
 
     /// [`PlausibleOptions::uncross_stuck`] on the whole clip's solved frames (`solved`): plans
@@ -625,6 +651,7 @@ impl<'a> Prepared<'a> {
         }
         let feet = [Some(left.clone()), Some(right.clone())];
         let mut targets = unplanned.clone();
+        let heading = self.heading();
         let plan = crate::feet::plan_uncrossing(
             &feet,
             contacts,
@@ -632,7 +659,7 @@ impl<'a> Prepared<'a> {
             self.slots,
             self.fps,
             &options.feet,
-            &phases,
+            &crate::feet::Uncrossing { uncross: &phases, heading: &heading },
         );
         let slots = self.slots.max(1);
         let differs = |t: &usize| {
