@@ -16,7 +16,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
 use crate::constraints::{Ground, SelfCollision};
-use crate::feet::{FootPlan, RobotFoot};
+use crate::feet::{is_descendant, FootPlan, RobotFoot};
 use crate::lie::Pose;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 use crate::solver::{FrameDiagnostics, PointTask, Solver, SolverOptions, TaskSpec};
@@ -511,15 +511,16 @@ impl<'a> Prepared<'a> {
         self.plan = Some((feet, plan));
     }
 
+    /// The robot body a task follows the human root's target with.
+    fn root_body(&self) -> Option<usize> {
+        self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
+    }
+
     /// Per frame, the yaw (rad) the robot's pelvis is to face: the root target's turn of the
     /// body's forward direction (world +x at `qpos0`, as for the feet). Empty when no task
     /// follows the root target.
     fn heading(&self) -> Vec<f64> {
-        let Some(body) =
-            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
-        else {
-            return Vec::new();
-        };
+        let Some(body) = self.root_body() else { return Vec::new() };
         let mut data = mjcf::Data::new(self.model);
         self.model.kinematics(&self.model.qpos0, &mut data);
         let forward = data.xquat[body].inverse() * Vector3::x();
@@ -587,25 +588,27 @@ impl<'a> Prepared<'a> {
             .filter_map(|foot| self.tracked.iter().position(|&(_, slot)| slot == foot.slot))
             .collect();
         // The geom pairs between the two legs: each leg is the subtree of the foot's highest
-        // ancestor that is not also the other foot's.
-        let ancestors = |b: usize| {
-            std::iter::successors(Some(b), |&b| (b != 0).then(|| model.bodies[b].parent))
-                .collect::<Vec<usize>>()
-        };
-        let (up_left, up_right) = (ancestors(left.body), ancestors(right.body));
-        let top = |up: &[usize], other: &[usize]| {
-            up.iter().take_while(|b| !other.contains(b)).last().copied()
+        // ancestor that the other foot does not hang from (as `feet::leg_length` walks up).
+        let top = |foot: usize, other: usize| {
+            if is_descendant(model, other, foot) {
+                return None;
+            }
+            let mut body = foot;
+            while !is_descendant(model, other, model.bodies[body].parent) {
+                body = model.bodies[body].parent;
+            }
+            Some(body)
         };
         let (Some(top_left), Some(top_right)) =
-            (top(&up_left, &up_right), top(&up_right, &up_left))
+            (top(left.body, right.body), top(right.body, left.body))
         else {
             return None;
         };
         let leg_of = |g: usize| {
-            let up = ancestors(model.geoms[g].body);
-            if up.contains(&top_left) {
+            let body = model.geoms[g].body;
+            if is_descendant(model, body, top_left) {
                 Some(0)
-            } else if up.contains(&top_right) {
+            } else if is_descendant(model, body, top_right) {
                 Some(1)
             } else {
                 None
@@ -617,9 +620,7 @@ impl<'a> Prepared<'a> {
             .into_iter()
             .filter(|&[a, b]| matches!((leg_of(a), leg_of(b)), (Some(x), Some(y)) if x != y))
             .collect();
-        // The body that follows the human root's target.
-        let root =
-            self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)?;
+        let root = self.root_body()?;
         let nq = model.nq;
         let mut data = mjcf::Data::new(model);
         // A frame is stuck where a planted foot is far from its target, the legs touch and the
