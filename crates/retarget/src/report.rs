@@ -72,6 +72,75 @@
 //! - **Joint speed over limit**: per hinge or slide joint with a published
 //!   [`mjcf::Joint::velocity_limit`], frames × joints with `|q̇| > limit` (`q̇` as above) and the
 //!   largest `|q̇| / limit`; `None` when no joint has a limit.
+//!
+//! Motion over time, the root included (issue 30):
+//!
+//! - **Root acceleration** ([`RootAcceleration`]): `p` the root body's world position (MuJoCo
+//!   body 1, the floating base: the free joint's `qpos` translation), at the interior frames
+//!   `a_t = (p[t+1] − 2 p[t] + p[t−1]) · fps²`; mean `|a|` (m/s²), the frames with
+//!   `|a| > 2 g` (g = 9.81 m/s²) and their share of the interior frames, the max. The same
+//!   for the root body's target position (`target_pos`) when the motion has targets and the
+//!   root is one of them: with GMR's configs the scaled human's pelvis (in a `--gmr` motion,
+//!   GMR's own pelvis target).
+//! - **Jitter over every velocity coordinate** ([`Jitter`]; nv as MuJoCo counts them): the
+//!   velocity between consecutive frames as `mj_differentiatePos` computes it,
+//!   `v[t+½] = (q[t+1] ⊖ q[t]) · fps`: a free joint's translation `(p[t+1] − p[t]) · fps` in the
+//!   world frame and its rotation `log(q[t]⁻¹ q[t+1]) · fps` (the rotation vector, the shorter
+//!   way round) in the body frame; a ball joint's rotation the same; a hinge or slide joint
+//!   `(q[t+1] − q[t]) · fps`. The acceleration at interior frame t is
+//!   `(v[t+½] − v[t−½]) · fps` (for hinge and slide joints exactly the second difference
+//!   above). A group's jitter is the mean of `|q̈_i|` over interior frames and the group's
+//!   coordinates: **root translation** (3, m/s²), **root rotation** (3, rad/s²), **joints**
+//!   (every other coordinate), and **all** nv coordinates together (units mixed). The
+//!   per-joint `jitter` above stays as it was (hinge and slide joints only).
+//! - **Dynamics check** ([`Dynamics`], per frame [`FrameDynamics`], [`dynamics_frames`];
+//!   tunables [`DynamicsOptions`]): inverse dynamics of the floating base at the centroidal
+//!   level. Mass model: every body's [`mjcf::Body::inertial`] (mass `m_i`, centre of mass
+//!   `x_i`, principal inertia `I_i` in the frame `R_i`); a body without inertial and without
+//!   geoms is massless, as in MuJoCo; one with geoms but no inertial (MuJoCo would take its
+//!   mass from them) makes the check **not available**, with that reason
+//!   ([`QualityReport::dynamics_unavailable`]), as does a model without any mass. `m = Σ m_i`,
+//!   `c = Σ m_i x_i / m`.
+//!   - *Velocities* by central differences at the clip's rate (numpy's `gradient`), per body:
+//!     `ẋ_i[t] = (x_i[t+1] − x_i[t−1]) · fps/2`, the world angular velocity
+//!     `ω_i[t] = log(R_i[t+1] R_i[t−1]⁻¹) · fps/2`. The centroidal angular momentum
+//!     `L_c[t] = Σ m_i (x_i − c) × ẋ_i + R_i I_i R_iᵀ ω_i`.
+//!   - *Accelerations* by central differences of those: `c̈[t] = (c[t+2] − 2 c[t] + c[t−2]) ·
+//!     fps²/4` and `L̇_c[t] = (L_c[t+1] − L_c[t−1]) · fps/2`. Each reads the 5 frames
+//!     t−2..t+2 and is the centred average of the three-point rates at t−1, t, t+1 with
+//!     weights ¼, ½, ¼ (for `c̈`: `(a[t−1] + 2 a[t] + a[t+1]) / 4`, `a` the second
+//!     differences): the 5-frame centred average. Checked frames: 2..T−3.
+//!   - *Needed wrench* about `c`: `W = (m (c̈ − g), L̇_c)`, `g = (0, 0, −9.81)` m/s²
+//!     (standing still it is `(0, 0, m g)` and no torque).
+//!   - *Contacts*: the bottom points of every collision geom (primitives with `contype` or
+//!     `conaffinity`): a sphere's bottom, a capsule's bottom at each end, a box's eight
+//!     corners, a cylinder's lowest rim point and four rim points (along its x and y) on each
+//!     cap, an ellipsoid's bottom. A point is a contact at frame t when it is within
+//!     [`DynamicsOptions::contact_height`] (1 cm) of the floor (`z − ground < 1 cm`, below
+//!     included) at t−1, t or t+1, the frames whose accelerations the average reads (a foot
+//!     that leaves the floor at t pushed in the averaged rate); its position is the one at t.
+//!   - *Forces*: at each contact point a force in the pyramid of
+//!     [`DynamicsOptions::cone_edges`] (8) edges inscribed in the friction cone
+//!     `|f_t| ≤ μ f_z`, μ = [`DynamicsOptions::friction`] (0.8): `f = Σ_j λ_j d_j`, `λ_j ≥ 0`,
+//!     `d_j ∝ (μ cos 2πj/8, μ sin 2πj/8, 1)` (tangential friction at least `μ cos(π/8) =
+//!     0.92 μ` in every direction). The `λ` minimise the residual `‖W_n − Σ λ_j A_j‖` in the
+//!     normalised units below (non-negative least squares, Lawson–Hanson).
+//!   - *Residual* (m·g): force part `|F_res| / (m g)`, torque part (about `c`)
+//!     `|τ_res| / (m g L)` with `L` ([`Dynamics::lever_m`]) the height of the centre of mass
+//!     above the lowest collision point at `qpos0` (the robot standing; 1 m where that is not
+//!     positive; G1 0.71 m, T1 0.63 m); the residual is `√(force² + torque²)`. Reported: its mean, p95
+//!     and max over checked frames, the frames over [`DynamicsOptions::threshold`] (0.1 m·g)
+//!     and their share, the same over support frames (with a contact) alone.
+//!   - *Centre of pressure*: in a support frame whose needed force pushes up by the threshold
+//!     or more (`F_z ≥ 0.1 m g`; as `F_z` goes to 0 the point runs off to infinity),
+//!     the needed wrench's zero-moment point on the floor `p` (where
+//!     `τ + (c − p) × F` has no horizontal part) and its distance outside the convex hull of
+//!     the contact points seen from above (a segment or a point with fewer; 0 inside); mean,
+//!     p95, max (cm) and the frames outside by more than
+//!     [`DynamicsOptions::cop_tolerance`] (1 cm).
+//!   - *Flight*: checked frames without any contact point. The needed wrench is all residual
+//!     (a ballistic centre of mass and a constant `L_c` need none): mean, p95, max (m·g), the
+//!     frames over the threshold and their share.
 
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
@@ -84,6 +153,13 @@ use std::fmt;
 
 use nalgebra::Vector3;
 use serde::Serialize;
+
+mod dynamics;
+mod nnls;
+mod rates;
+
+pub use dynamics::{CentreOfPressure, Dynamics, DynamicsOptions, Flight, FrameDynamics};
+pub use rates::{AccelStats, Jitter, RootAcceleration, GRAVITY};
 
 use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
@@ -125,6 +201,8 @@ pub struct ReportOptions {
     /// [`crate::IkConfig::position_targets`]); the others get no position error. `None`:
     /// every target body.
     pub position_targets: Option<Vec<String>>,
+    /// The dynamics check's contacts, friction and thresholds.
+    pub dynamics: DynamicsOptions,
 }
 
 impl Default for ReportOptions {
@@ -143,6 +221,7 @@ impl Default for ReportOptions {
             sole_band: [-0.005, 0.01],
             self_collision_depth: 0.01,
             position_targets: None,
+            dynamics: DynamicsOptions::default(),
         }
     }
 }
@@ -340,6 +419,14 @@ pub struct QualityReport {
     pub stance: Option<Stance>,
     /// `None` when no joint has a published speed limit.
     pub joint_speed: Option<JointSpeedLimits>,
+    /// The root's acceleration, and its target's.
+    pub root_acceleration: RootAcceleration,
+    /// Mean `|q̈|` over every velocity coordinate, the root's included.
+    pub jitter: Jitter,
+    /// The dynamics check; `None` when the model's masses are not known or the clip is
+    /// shorter than 5 frames ([`QualityReport::dynamics_unavailable`] says why).
+    pub dynamics: Option<Dynamics>,
+    pub dynamics_unavailable: Option<String>,
 }
 
 /// Computes the [`QualityReport`] of `motion` on `model` (the robot it was solved for).
@@ -385,6 +472,12 @@ pub fn report(
         (0..frames).map(|t| (poses.pos(t, b) + (poses.quat(t, b) * toe[i])).xy()).collect()
     });
     let contacts = motion.contacts.as_ref().map(|c| [&c.left[..], &c.right[..]]);
+    let (dynamics, dynamics_unavailable) =
+        match dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics) {
+            Ok(c) if c.frames.is_empty() => (None, Some("fewer than 5 frames".to_owned())),
+            Ok(c) => (Some(dynamics::summarise(&c, &opts.dynamics)), None),
+            Err(reason) => (None, Some(reason)),
+        };
     Ok(QualityReport {
         robot: model.name.clone(),
         frames,
@@ -400,7 +493,26 @@ pub fn report(
         skating: contacts.map(|c| skating(&foot_xy, c, motion.fps, opts.skate_speed)),
         stance: contacts.map(|c| stance(&[&heights[0].0, &heights[1].0], c, opts)),
         joint_speed: joint_speed(motion, model),
+        root_acceleration: rates::root_acceleration(motion, model, &poses),
+        jitter: rates::jitter(motion, model),
+        dynamics,
+        dynamics_unavailable,
     })
+}
+
+/// The dynamics check of every checked frame (frames 2..T−3; module documentation), e.g. to
+/// find the frames behind [`QualityReport::dynamics`]. An [`Error::Options`] when the model's
+/// masses are not known.
+pub fn dynamics_frames(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    opts: &ReportOptions,
+) -> Result<Vec<FrameDynamics>, Error> {
+    check_motion(motion, model)?;
+    let poses = body_poses(motion, model);
+    dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics)
+        .map(|c| c.frames)
+        .map_err(Error::Options)
 }
 
 /// Ground penetration of every collision geom and self-collision, in one pass of FK.
@@ -995,9 +1107,84 @@ impl QualityReport {
                 f,
                 "joint speed limits: {} frames × joints over ({} joints with limits), worst {:.2}× ({})",
                 j.violations, j.joints, j.worst_ratio, j.worst_joint
-            ),
-            None => writeln!(f, "joint speed limits: - (none published)"),
+            )?,
+            None => writeln!(f, "joint speed limits: - (none published)")?,
         }
+        self.fmt_over_time(f)
+    }
+
+    /// Root acceleration, jitter over nv and the dynamics check, one line or two each.
+    fn fmt_over_time(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let r = &self.root_acceleration;
+        let accel = |a: &AccelStats| {
+            format!(
+                "mean {:.1} m/s², {} frames ({:.1}%) over 2 g, max {:.1} m/s²",
+                a.mean_mps2,
+                a.frames_over,
+                a.share_over * 100.0,
+                a.max_mps2
+            )
+        };
+        writeln!(f, "\nroot acceleration ({}): {}", r.body, accel(&r.motion))?;
+        if let Some(t) = &r.target {
+            writeln!(f, "  its target:  {}", accel(t))?;
+        }
+        let j = &self.jitter;
+        let opt = |v: Option<f64>| v.map_or_else(|| "-".to_owned(), |v| format!("{v:.2}"));
+        writeln!(
+            f,
+            "jitter mean |q̈| over all {} velocity coordinates: {:.2}; root translation {} m/s², root rotation {} rad/s², joints {:.2}",
+            j.coordinates,
+            j.all,
+            opt(j.root_translation),
+            opt(j.root_rotation),
+            j.joints
+        )?;
+        let Some(d) = &self.dynamics else {
+            let why = self.dynamics_unavailable.as_deref().unwrap_or("-");
+            return writeln!(f, "dynamics: not available ({why})");
+        };
+        writeln!(
+            f,
+            "dynamics ({:.1} kg, L {:.2} m, μ {}, {}-edge cones, contact within {:.1} cm): residual wrench mean {:.3} / p95 {:.3} / max {:.3} m·g; {} of {} frames ({:.1}%) over {} m·g ({} of {} support frames)",
+            d.mass_kg,
+            d.lever_m,
+            d.friction,
+            d.cone_edges,
+            d.contact_height_cm,
+            d.residual_mg.mean,
+            d.residual_mg.p95,
+            d.residual_mg.max,
+            d.frames_over,
+            d.frames,
+            d.share_over * 100.0,
+            d.threshold_mg,
+            d.support_frames_over,
+            d.support_frames
+        )?;
+        let c = &d.cop;
+        writeln!(
+            f,
+            "  centre of pressure outside the support: mean {:.2} / p95 {:.2} / max {:.2} cm, {} of {} frames ({:.1}%) beyond {:.1} cm",
+            c.outside_cm.mean,
+            c.outside_cm.p95,
+            c.outside_cm.max,
+            c.frames_outside,
+            c.frames,
+            c.share_outside * 100.0,
+            c.tolerance_cm
+        )?;
+        let fl = &d.flight;
+        writeln!(
+            f,
+            "  flight (no contact): {} frames, needed wrench mean {:.3} / max {:.3} m·g, {} ({:.1}%) over {} m·g",
+            fl.frames,
+            fl.residual_mg.mean,
+            fl.residual_mg.max,
+            fl.frames_over,
+            fl.share_over * 100.0,
+            d.threshold_mg
+        )
     }
 }
 

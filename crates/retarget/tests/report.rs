@@ -492,3 +492,192 @@ fn joint_speed_over_published_limits() {
     assert_eq!(json["joint_speed"]["violations"], FRAMES);
     assert!(rep.to_string().contains("joint speed limits: 40 frames × joints over (2 joints"));
 }
+
+// Motion over time (issue 30): root acceleration, jitter over nv, the dynamics check.
+
+/// The shipped G1 at `qpos0` with its root at `root(t)` (m) turned by `yaw(t)` (rad) about z.
+fn root_motion(
+    model: &mjcf::Model,
+    frames: usize,
+    root: impl Fn(f64) -> Vector3<f64>,
+    yaw: impl Fn(f64) -> f64,
+) -> RobotMotion {
+    let mut qpos = Vec::new();
+    for t in 0..frames {
+        let s = t as f64 / FPS;
+        let mut q = model.qpos0.clone();
+        let p = root(s);
+        q[..3].copy_from_slice(&[p.x, p.y, p.z]);
+        let h = yaw(s) / 2.0;
+        q[3..7].copy_from_slice(&[h.cos(), 0.0, 0.0, h.sin()]);
+        qpos.extend(q);
+    }
+    motion_from(model, qpos)
+}
+
+const G: f64 = retarget::report::GRAVITY;
+
+#[test]
+fn free_fall_accelerates_the_root_by_g_and_needs_no_wrench() {
+    let model = repo_g1();
+    let z0 = standing_height(&model, 3.0);
+    // Thrown forward and up: 2 m/s ahead, 4 m/s up, falling at g; no contact (3 m up and more).
+    let motion = root_motion(
+        &model,
+        FRAMES,
+        |s| Vector3::new(2.0 * s, 0.0, z0 + 4.0 * s - G * s * s / 2.0),
+        |_| 0.3,
+    );
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let a = &rep.root_acceleration;
+    assert_eq!(a.body, "pelvis");
+    assert_eq!((a.motion.frames, a.motion.frames_over), (FRAMES - 2, 0), "{a:?}");
+    assert!((a.motion.mean_mps2 - G).abs() < 1e-9 && (a.motion.max_mps2 - G).abs() < 1e-9);
+    assert!(a.target.is_none(), "no targets");
+    let d = rep.dynamics.as_ref().expect("the G1 has its inertials");
+    assert!((d.mass_kg - 34.4).abs() < 0.1, "{}", d.mass_kg);
+    assert_eq!((d.frames, d.support_frames, d.flight.frames), (FRAMES - 4, 0, FRAMES - 4));
+    assert!(d.flight.residual_mg.max < 1e-9, "{:?}", d.flight);
+    assert_eq!(d.flight.frames_over, 0);
+    // Held still in the air instead, it needs its whole weight.
+    let held = root_motion(&model, FRAMES, |_| Vector3::new(0.0, 0.0, z0), |_| 0.3);
+    let d = report(&held, &model, &ReportOptions::default()).unwrap().dynamics.unwrap();
+    assert!((d.flight.residual_mg.mean - 1.0).abs() < 1e-9, "{:?}", d.flight);
+    assert_eq!((d.flight.share_over, d.share_over), (1.0, 1.0));
+}
+
+#[test]
+fn a_kick_of_the_root_is_one_frame_over_2g() {
+    let model = repo_g1();
+    let z = standing_height(&model, 0.5);
+    // At rest until frame 10, then 1 m/s sideways: one second difference of 1/30 m, 30 m/s².
+    let motion =
+        root_motion(&model, FRAMES, |s| Vector3::new(0.0, (s - 10.0 / FPS).max(0.0), z), |_| 0.0);
+    let a = report(&motion, &model, &ReportOptions::default()).unwrap().root_acceleration;
+    assert_eq!(a.motion.frames_over, 1, "{a:?}");
+    assert!((a.motion.max_mps2 - FPS).abs() < 1e-9, "{a:?}");
+    assert!((a.motion.mean_mps2 - FPS / (FRAMES - 2) as f64).abs() < 1e-9);
+    assert!((a.motion.share_over - 1.0 / (FRAMES - 2) as f64).abs() < 1e-15);
+}
+
+#[test]
+fn the_root_targets_acceleration_is_the_scaled_humans() {
+    let model = repo_g1();
+    let z = standing_height(&model, 0.0);
+    let mut motion = root_motion(&model, FRAMES, |_| Vector3::new(0.0, 0.0, z), |_| 0.0);
+    // Targets: the pelvis bobbing at 3 g (a parabola), a hand target moving anyhow.
+    let names = vec!["left_wrist_yaw_link".to_owned(), "pelvis".to_owned()];
+    let mut pos = Vec::new();
+    for t in 0..FRAMES {
+        let s = t as f64 / FPS;
+        pos.push(Vector3::new(s * s * 50.0, 0.0, 1.0));
+        pos.push(Vector3::new(0.0, 0.0, 0.8 + 1.5 * G * s * s));
+    }
+    let quat = vec![nalgebra::UnitQuaternion::identity(); pos.len()];
+    motion.targets = Some(TrackedTargets { body_names: names, pos, quat });
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let t = rep.root_acceleration.target.expect("the pelvis is a target");
+    assert!((t.mean_mps2 - 3.0 * G).abs() < 1e-6 && t.share_over == 1.0, "{t:?}");
+    assert_eq!(rep.root_acceleration.motion.mean_mps2, 0.0);
+    assert!(rep.to_string().contains("its target:  mean 29.4 m/s²"), "{rep}");
+}
+
+#[test]
+fn jitter_counts_every_velocity_coordinate() {
+    let model = repo_g1();
+    let z = standing_height(&model, 0.0);
+    // Root: 3 m/s² along x, yaw at 2 rad/s²; the left knee at 5 rad/s²; the rest still.
+    let mut motion = root_motion(&model, FRAMES, |s| Vector3::new(1.5 * s * s, 0.0, z), |s| s * s);
+    let knee = model.joints[model.joint_id("left_knee_joint").unwrap()].qpos_adr;
+    for t in 0..FRAMES {
+        let s = t as f64 / FPS;
+        motion.qpos[t * model.nq + knee] = 0.3 + 2.5 * s * s;
+    }
+    let j = report(&motion, &model, &ReportOptions::default()).unwrap().jitter;
+    assert_eq!(j.coordinates, model.nv);
+    // Mean |q̈| over each group's coordinates: one of three moves in each root group.
+    assert!((j.root_translation.unwrap() - 1.0).abs() < 1e-6, "{j:?}");
+    assert!((j.root_rotation.unwrap() - 2.0 / 3.0).abs() < 1e-6, "{j:?}");
+    let joints = (model.nv - 6) as f64;
+    assert!((j.joints - 5.0 / joints).abs() < 1e-6, "{j:?}");
+    assert!((j.all - 10.0 / model.nv as f64).abs() < 1e-6, "{j:?}");
+    // A yaw past half a turn between frames is the shorter way round: no jump at ±π.
+    let spin = root_motion(&model, FRAMES, |_| Vector3::new(0.0, 0.0, z), |s| 0.5 * FPS * s);
+    let j = report(&spin, &model, &ReportOptions::default()).unwrap().jitter;
+    assert!(j.root_rotation.unwrap() < 1e-9, "{j:?}");
+}
+
+#[test]
+fn standing_on_the_floor_needs_no_extra_wrench_and_floating_needs_its_weight() {
+    let model = repo_g1();
+    let stand = standing_height(&model, 0.001);
+    let motion = root_motion(&model, FRAMES, |_| Vector3::new(0.3, -0.2, stand), |_| 0.7);
+    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    let d = rep.dynamics.as_ref().unwrap();
+    assert_eq!((d.support_frames, d.flight.frames), (FRAMES - 4, 0), "{d:?}");
+    assert!(d.residual_mg.max < 1e-6, "{:?}", d.residual_mg);
+    assert_eq!((d.frames_over, d.cop.frames, d.cop.frames_outside), (0, FRAMES - 4, 0));
+    assert_eq!(d.cop.outside_cm.max, 0.0);
+    // 5 cm up: no point within 1 cm of the floor, the whole weight is missing.
+    let high = standing_height(&model, 0.05);
+    let floating = root_motion(&model, FRAMES, |_| Vector3::new(0.3, -0.2, high), |_| 0.7);
+    let d = report(&floating, &model, &ReportOptions::default()).unwrap().dynamics.unwrap();
+    assert_eq!((d.support_frames, d.flight.frames), (0, FRAMES - 4));
+    assert!(
+        (d.residual_mg.mean - 1.0).abs() < 1e-9 && (d.residual_force_mg.max - 1.0).abs() < 1e-9
+    );
+    assert!(d.residual_torque_mgl.max < 1e-9 && d.share_over == 1.0, "{d:?}");
+    // The feet pitched at the ankles (0.5 rad), the root as high: one edge of each sole is on
+    // the floor, not under the centre of mass, which no force there can hold up alone.
+    let mut tiptoe = motion.clone();
+    for side in ["left", "right"] {
+        let a =
+            model.joints[model.joint_id(&format!("{side}_ankle_pitch_joint")).unwrap()].qpos_adr;
+        for t in 0..FRAMES {
+            tiptoe.qpos[t * model.nq + a] = 0.5;
+        }
+    }
+    let d = report(&tiptoe, &model, &ReportOptions::default()).unwrap().dynamics.unwrap();
+    assert_eq!((d.support_frames, d.cop.frames_outside), (FRAMES - 4, FRAMES - 4), "{d:?}");
+    let out = d.cop.outside_cm;
+    assert!(out.mean > 3.0 && out.max < 15.0 && d.residual_mg.mean > 0.03, "{d:?}");
+}
+
+#[test]
+fn the_dynamics_check_is_not_available_without_masses() {
+    // The toy robot's bodies have geoms and no inertials: MuJoCo would infer their masses.
+    let model = mjcf::Model::from_xml_str(TOY, None).unwrap();
+    let frames: Vec<(f64, f64)> = (0..10).map(|_| (1.0, 0.0)).collect();
+    let rep = report(&toy_motion(&model, &frames), &model, &toy_options()).unwrap();
+    assert!(rep.dynamics.is_none());
+    let why = rep.dynamics_unavailable.as_deref().unwrap();
+    assert!(why.contains("\"base\" has geoms but no inertial"), "{why}");
+    assert!(rep.to_string().contains("dynamics: not available (body \"base\""), "{rep}");
+    let err =
+        retarget::report::dynamics_frames(&toy_motion(&model, &frames), &model, &toy_options());
+    assert!(err.is_err());
+}
+
+#[test]
+fn the_json_carries_the_new_sections() {
+    let model = repo_g1();
+    let (motion, _) = sliding_motion(&model, 0.3, 0.001);
+    let json =
+        serde_json::to_value(report(&motion, &model, &ReportOptions::default()).unwrap()).unwrap();
+    for key in ["mean_mps2", "max_mps2", "share_over", "frames_over", "frames"] {
+        assert!(json["root_acceleration"]["motion"][key].is_number(), "{key}: {json}");
+    }
+    assert!(json["root_acceleration"]["target"].is_null());
+    assert_eq!(json["root_acceleration"]["threshold_mps2"], 2.0 * G);
+    for key in ["root_translation", "root_rotation", "joints", "all", "coordinates"] {
+        assert!(json["jitter"][key].is_number(), "{key}");
+    }
+    let d = &json["dynamics"];
+    for key in ["mass_kg", "lever_m", "share_over", "frames_over", "support_share_over"] {
+        assert!(d[key].is_number(), "{key}: {d}");
+    }
+    assert!(d["residual_mg"]["p95"].is_number() && d["flight"]["residual_mg"]["mean"].is_number());
+    assert!(d["cop"]["outside_cm"]["max"].is_number() && d["cop"]["share_outside"].is_number());
+    assert_eq!((d["friction"].as_f64(), d["cone_edges"].as_u64()), (Some(0.8), Some(8)));
+    assert!(json["dynamics_unavailable"].is_null());
+}

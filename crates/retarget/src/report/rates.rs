@@ -1,0 +1,178 @@
+//! Root acceleration and the jitter over every velocity coordinate (definitions in the
+//! [`crate::report`] module documentation).
+
+// Exception to `indexing_slicing`, as in `report`: the motion was checked against the model
+// (`check_motion`), so every qpos address, frame and body index comes from them.
+#![allow(clippy::indexing_slicing)]
+
+use nalgebra::{UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::mean;
+use crate::motion::RobotMotion;
+use crate::writers::BodyPoses;
+
+/// Standard gravity (m/s²), the unit of [`RootAcceleration::threshold_mps2`] and of the
+/// dynamics check's m·g.
+pub const GRAVITY: f64 = 9.81;
+
+/// Acceleration of one trajectory of points: `|a|` over the interior frames.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AccelStats {
+    /// Interior frames measured (frames − 2).
+    pub frames: usize,
+    /// Mean `|a|` (m/s²).
+    pub mean_mps2: f64,
+    pub max_mps2: f64,
+    /// Frames with `|a|` above [`RootAcceleration::threshold_mps2`].
+    pub frames_over: usize,
+    /// `frames_over / frames` (0 without frames).
+    pub share_over: f64,
+}
+
+/// Acceleration of the root body (the floating base) and of its IK target.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RootAcceleration {
+    /// The root body (MuJoCo body 1).
+    pub body: String,
+    /// 2 g (m/s²).
+    pub threshold_mps2: f64,
+    /// The robot's root, from its world position (the free joint's `qpos` translation).
+    pub motion: AccelStats,
+    /// The root body's target position (the scaled human's pelvis with GMR's configs), when
+    /// the motion has targets and one of them is the root body.
+    pub target: Option<AccelStats>,
+}
+
+/// Mean `|q̈|` over every velocity coordinate (MuJoCo's nv), by group.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Jitter {
+    /// Velocity coordinates (nv).
+    pub coordinates: usize,
+    /// The free root's 3 translational coordinates (m/s², world frame); `None` without a
+    /// free joint.
+    pub root_translation: Option<f64>,
+    /// The free root's 3 rotational coordinates (rad/s², body frame); `None` without a free
+    /// joint.
+    pub root_rotation: Option<f64>,
+    /// Every other coordinate: hinge and slide joints, ball joints' 3 (rad/s² or m/s²); 0
+    /// without any.
+    pub joints: f64,
+    /// Over all nv coordinates (units mixed as above).
+    pub all: f64,
+}
+
+/// Root acceleration of the motion and of its root target.
+pub(super) fn root_acceleration(
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    poses: &BodyPoses,
+) -> RootAcceleration {
+    let frames = motion.num_frames();
+    let robot: Vec<Vector3<f64>> = (0..frames).map(|t| poses.pos(t, 0)).collect();
+    let body = model.bodies.get(1).map(|b| b.name.clone()).unwrap_or_default();
+    let target = motion.targets.as_ref().and_then(|targets| {
+        let k = targets.body_names.len();
+        let j = targets.body_names.iter().position(|n| *n == body)?;
+        let p: Vec<Vector3<f64>> = (0..frames).map(|t| targets.pos[t * k + j]).collect();
+        Some(accel_stats(&p, motion.fps))
+    });
+    RootAcceleration {
+        body,
+        threshold_mps2: 2.0 * GRAVITY,
+        motion: accel_stats(&robot, motion.fps),
+        target,
+    }
+}
+
+/// `|p[t+1] − 2 p[t] + p[t−1]| · fps²` over the interior frames.
+#[must_use]
+pub(super) fn accel_stats(p: &[Vector3<f64>], fps: f64) -> AccelStats {
+    let a: Vec<f64> = p.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).norm() * fps * fps).collect();
+    let frames_over = a.iter().filter(|a| **a > 2.0 * GRAVITY).count();
+    AccelStats {
+        frames: a.len(),
+        mean_mps2: mean(&a),
+        max_mps2: a.iter().copied().fold(0.0, f64::max),
+        frames_over,
+        share_over: super::ratio(frames_over, a.len()),
+    }
+}
+
+/// Which group a velocity coordinate belongs to.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Group {
+    RootTranslation,
+    RootRotation,
+    Joint,
+}
+
+/// Velocity between two configurations as `mj_differentiatePos` computes it, with the group
+/// of each coordinate: free joints' translation in the world frame, rotations (free and ball)
+/// in the body frame as `log(q_a⁻¹ q_b)` (the shorter way round), scalars `(b − a)`, all
+/// times `fps`.
+fn differentiate(model: &mjcf::Model, a: &[f64], b: &[f64], fps: f64, out: &mut Vec<(Group, f64)>) {
+    out.clear();
+    let quat = |q: &[f64], at: usize| {
+        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            q[at],
+            q[at + 1],
+            q[at + 2],
+            q[at + 3],
+        ))
+    };
+    let rotation = |at: usize| (quat(a, at).inverse() * quat(b, at)).scaled_axis() * fps;
+    for joint in &model.joints {
+        let i = joint.qpos_adr;
+        match joint.kind {
+            mjcf::JointType::Free => {
+                out.extend((0..3).map(|k| (Group::RootTranslation, (b[i + k] - a[i + k]) * fps)));
+                out.extend(rotation(i + 3).iter().map(|w| (Group::RootRotation, *w)));
+            }
+            mjcf::JointType::Ball => out.extend(rotation(i).iter().map(|w| (Group::Joint, *w))),
+            mjcf::JointType::Hinge | mjcf::JointType::Slide => {
+                out.push((Group::Joint, (b[i] - a[i]) * fps));
+            }
+        }
+    }
+}
+
+/// Jitter over every velocity coordinate: the velocities between consecutive frames
+/// ([`differentiate`]), their differences times fps at the interior frames, mean `|·|`.
+pub(super) fn jitter(motion: &RobotMotion, model: &mjcf::Model) -> Jitter {
+    let frames = motion.num_frames();
+    let fps = motion.fps;
+    let (mut prev, mut next) = (Vec::new(), Vec::new());
+    // Sum of |q̈| and count per group: root translation, root rotation, joints.
+    let mut sums = [(0.0, 0usize); 3];
+    let slot = |g: Group| match g {
+        Group::RootTranslation => 0,
+        Group::RootRotation => 1,
+        Group::Joint => 2,
+    };
+    for t in 1..frames.saturating_sub(1) {
+        if t == 1 {
+            differentiate(model, motion.frame(0), motion.frame(1), fps, &mut prev);
+        }
+        differentiate(model, motion.frame(t), motion.frame(t + 1), fps, &mut next);
+        for ((g, v0), (_, v1)) in prev.iter().zip(&next) {
+            let s = &mut sums[slot(*g)];
+            s.0 += ((v1 - v0) * fps).abs();
+            s.1 += 1;
+        }
+        std::mem::swap(&mut prev, &mut next);
+    }
+    let group = |i: usize| {
+        let (s, n): (f64, usize) = sums[i];
+        (n > 0).then(|| s / n as f64)
+    };
+    let has_free = model.joints.iter().any(|j| j.kind == mjcf::JointType::Free);
+    let (total, count) = sums.iter().fold((0.0, 0), |(s, n), (a, b)| (s + a, n + b));
+    Jitter {
+        coordinates: model.nv,
+        root_translation: group(0).or(has_free.then_some(0.0)),
+        root_rotation: group(1).or(has_free.then_some(0.0)),
+        joints: group(2).unwrap_or(0.0),
+        all: if count > 0 { total / count as f64 } else { 0.0 },
+    }
+}
