@@ -45,6 +45,11 @@ pub struct ReportArgs {
     /// Count frames with a joint speed above this (rad/s).
     #[arg(long)]
     pub velocity_limit: Option<f64>,
+    /// Also write the dynamics check of every checked frame as CSV (frame, contact points,
+    /// residual in m·g with its force and torque parts, centre of pressure outside the
+    /// support in m, the needed force in N and torque in N m).
+    #[arg(long, value_name = "OUT.csv")]
+    pub dynamics_frames: Option<PathBuf>,
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
@@ -83,6 +88,22 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.json {
         let mut text = serde_json::to_string_pretty(&rep)?;
         text.push('\n');
+        crate::atomic_write(path, text.as_bytes())?;
+    }
+    if let Some(path) = &args.dynamics_frames {
+        let frames = retarget::report::dynamics_frames(&motion, &model, &opts)?;
+        let mut text = String::from(
+            "frame,contacts,residual_mg,residual_force_mg,residual_torque_mgl,cop_outside_m,force_x,force_y,force_z,torque_x,torque_y,torque_z\n",
+        );
+        for d in &frames {
+            let cop = d.cop_outside.map_or_else(String::new, |c| format!("{c:.4}"));
+            let [fx, fy, fz] = d.force;
+            let [tx, ty, tz] = d.torque;
+            text.push_str(&format!(
+                "{},{},{:.6},{:.6},{:.6},{cop},{fx:.3},{fy:.3},{fz:.3},{tx:.3},{ty:.3},{tz:.3}\n",
+                d.frame, d.contacts, d.residual, d.residual_force, d.residual_torque
+            ));
+        }
         crate::atomic_write(path, text.as_bytes())?;
     }
     match std::io::stdout().lock().write_all(rep.to_string().as_bytes()) {

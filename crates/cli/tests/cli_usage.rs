@@ -308,3 +308,57 @@ fn report_measures_positions_only_where_they_are_targets() {
     let report_p95: f64 = row(&report, "pelvis")[1].parse().unwrap();
     assert!((summary_p95 / 10.0 - report_p95).abs() < 0.006, "{summary_p95} mm vs {report_p95} cm");
 }
+
+#[test]
+fn report_prints_and_writes_the_motion_over_time_sections() {
+    let Some(clip) = walk(40) else { return };
+    let dir = temp_dir("report-dynamics");
+    let bvh = dir.join("walk.bvh");
+    std::fs::write(&bvh, clip).unwrap();
+    let npz = dir.join("walk.npz");
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        "unitree_g1",
+        "-o",
+        npz.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (json, csv) = (dir.join("r.json"), dir.join("d.csv"));
+    let out = retarget(&[
+        "report",
+        npz.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--dynamics-frames",
+        csv.to_str().unwrap(),
+    ]);
+    let text = stdout(&out);
+    for line in [
+        "root acceleration (pelvis): mean",
+        "  its target:  mean",
+        "jitter mean |q̈| over all 35",
+        "dynamics (34.4 kg",
+    ] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let d = &rep["dynamics"];
+    // The CSV holds the frames the summary is made of: 2..=37, mean residual as reported.
+    let rows: Vec<Vec<String>> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    assert_eq!(rows.len(), 36);
+    assert_eq!((rows[0][0].as_str(), rows[35][0].as_str()), ("2", "37"));
+    let mean = rows.iter().map(|r| r[2].parse::<f64>().unwrap()).sum::<f64>() / 36.0;
+    let reported = d["residual_mg"]["mean"].as_f64().unwrap();
+    assert!((mean - reported).abs() < 1e-6, "{mean} vs {reported}");
+    let over = rows.iter().filter(|r| r[2].parse::<f64>().unwrap() > 0.1).count();
+    assert_eq!(d["frames_over"].as_u64(), Some(over as u64));
+    assert!(rep["root_acceleration"]["target"]["mean_mps2"].is_number());
+}
