@@ -40,7 +40,10 @@ PathLike = Union[str, "os.PathLike[str]"]
 def report(motion: Motion) -> Dict[str, Any]:
     """The quality report of ``motion`` (what ``retarget report`` prints) as a dict: tracking
     errors, joint limits and speeds, foot sliding and penetration, ground penetration,
-    self-collision, skating against the source's contacts."""
+    self-collision, skating against the source's contacts, the root's acceleration
+    (``root_acceleration``), jitter over every velocity coordinate (``jitter``) and the
+    dynamics check (``dynamics``; ``None`` with ``dynamics_unavailable`` saying why).
+    Definitions: docs/metrics.md."""
     return json.loads(motion.report_json())
 
 

@@ -82,3 +82,9 @@ def test_report_is_the_clis(tmp_path, cli, walk_outputs):
     assert report["joint_limits"] == expected["joint_limits"]
     assert report["ground_penetration"] == expected["ground_penetration"]
     assert report["self_collision"] == expected["self_collision"]
+    # Motion over time (issue 30): the root's acceleration and its target's, jitter over nv,
+    # the dynamics check.
+    for key in ("root_acceleration", "jitter", "dynamics", "dynamics_unavailable"):
+        assert report[key] == expected[key], key
+    assert report["root_acceleration"]["target"]["mean_mps2"] > 0
+    assert report["jitter"]["coordinates"] == 35 and report["dynamics"]["frames"] == 7180

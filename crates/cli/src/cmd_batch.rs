@@ -211,6 +211,7 @@ impl Job {
         };
         let report_options = retarget::report::ReportOptions {
             position_targets: Some(config.position_targets()),
+            root_target: Some(config.robot_root_name.clone()),
             ..retarget::report::ReportOptions::default()
         };
         let quality = self.retargeter.report(&motion, &report_options)?;

@@ -19,8 +19,9 @@ pub struct ReportArgs {
     #[arg(long)]
     pub robot: Option<String>,
     /// The IK config the motion was solved with: bodies without a position weight get no
-    /// position error. Default: the shipped config of a shipped robot (else every target
-    /// body's position is measured).
+    /// position error, and its `robot_root_name`'s target is the scaled human's pelvis.
+    /// Default: the shipped config of a shipped robot (else every target body's position is
+    /// measured, and the first target is the pelvis).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Also write the report as JSON to this file.
@@ -66,12 +67,11 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
             (model, stored)
         }
     };
-    let position_targets = match &args.config {
-        Some(path) => Some(retarget::IkConfig::from_file(path)?.position_targets()),
-        None => crate::cmd_retarget::shipped_config(&robot_arg)
-            .transpose()?
-            .map(|c| c.position_targets()),
+    let config = match &args.config {
+        Some(path) => Some(retarget::IkConfig::from_file(path)?),
+        None => crate::cmd_retarget::shipped_config(&robot_arg).transpose()?,
     };
+    let position_targets = config.as_ref().map(retarget::IkConfig::position_targets);
     let robot = if model.name.is_empty() { "(unnamed)" } else { model.name.as_str() };
     let opts = ReportOptions {
         feet: args.feet.map(|f| [f[0].clone(), f[1].clone()]),
@@ -81,6 +81,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         slide_speed: args.slide_speed,
         joint_velocity_limit: args.velocity_limit,
         position_targets,
+        root_target: config.map(|c| c.robot_root_name),
         ..ReportOptions::default()
     };
     let rep = report(&motion, &model, &opts)

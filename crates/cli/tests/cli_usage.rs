@@ -337,7 +337,7 @@ fn report_prints_and_writes_the_motion_over_time_sections() {
     let text = stdout(&out);
     for line in [
         "root acceleration (pelvis): mean",
-        "  its target:  mean",
+        "  scaled human (target of pelvis): mean",
         "jitter mean |q̈| over all 35",
         "dynamics (34.4 kg",
     ] {

@@ -79,9 +79,10 @@
 //!   body 1, the floating base: the free joint's `qpos` translation), at the interior frames
 //!   `a_t = (p[t+1] − 2 p[t] + p[t−1]) · fps²`; mean `|a|` (m/s²), the frames with
 //!   `|a| > 2 g` (g = 9.81 m/s²) and their share of the interior frames, the max. The same
-//!   for the root body's target position (`target_pos`) when the motion has targets and the
-//!   root is one of them: with GMR's configs the scaled human's pelvis (in a `--gmr` motion,
-//!   GMR's own pelvis target).
+//!   for the scaled human's pelvis: the target position (`target_pos`) of the config's root
+//!   body ([`ReportOptions::root_target`]: GMR's `robot_root_name`, the body the human's
+//!   pelvis drives, which need not be the floating base: the T1's `Waist` under its `Trunk`),
+//!   when the motion has targets; in a `--gmr` motion GMR's own pelvis target.
 //! - **Jitter over every velocity coordinate** ([`Jitter`]; nv as MuJoCo counts them): the
 //!   velocity between consecutive frames as `mj_differentiatePos` computes it,
 //!   `v[t+½] = (q[t+1] ⊖ q[t]) · fps`: a free joint's translation `(p[t+1] − p[t]) · fps` in the
@@ -201,6 +202,12 @@ pub struct ReportOptions {
     /// [`crate::IkConfig::position_targets`]); the others get no position error. `None`:
     /// every target body.
     pub position_targets: Option<Vec<String>>,
+    /// The robot body whose target is the scaled human's pelvis, for
+    /// [`RootAcceleration::target`]: the IK config's `robot_root_name` (GMR's root target;
+    /// the T1's `Waist`, tracked to the human's hips, not its floating base `Trunk`, tracked
+    /// to the chest). `None`: the motion's first target (GMR's configs, the shipped and the
+    /// derived ones begin their match table with the root).
+    pub root_target: Option<String>,
     /// The dynamics check's contacts, friction and thresholds.
     pub dynamics: DynamicsOptions,
 }
@@ -221,6 +228,7 @@ impl Default for ReportOptions {
             sole_band: [-0.005, 0.01],
             self_collision_depth: 0.01,
             position_targets: None,
+            root_target: None,
             dynamics: DynamicsOptions::default(),
         }
     }
@@ -493,7 +501,12 @@ pub fn report(
         skating: contacts.map(|c| skating(&foot_xy, c, motion.fps, opts.skate_speed)),
         stance: contacts.map(|c| stance(&[&heights[0].0, &heights[1].0], c, opts)),
         joint_speed: joint_speed(motion, model),
-        root_acceleration: rates::root_acceleration(motion, model, &poses),
+        root_acceleration: rates::root_acceleration(
+            motion,
+            model,
+            &poses,
+            opts.root_target.as_deref(),
+        ),
         jitter: rates::jitter(motion, model),
         dynamics,
         dynamics_unavailable,
@@ -1126,8 +1139,8 @@ impl QualityReport {
             )
         };
         writeln!(f, "\nroot acceleration ({}): {}", r.body, accel(&r.motion))?;
-        if let Some(t) = &r.target {
-            writeln!(f, "  its target:  {}", accel(t))?;
+        if let (Some(t), Some(body)) = (&r.target, &r.target_body) {
+            writeln!(f, "  scaled human (target of {body}): {}", accel(t))?;
         }
         let j = &self.jitter;
         let opt = |v: Option<f64>| v.map_or_else(|| "-".to_owned(), |v| format!("{v:.2}"));

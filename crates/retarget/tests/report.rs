@@ -575,11 +575,22 @@ fn the_root_targets_acceleration_is_the_scaled_humans() {
     }
     let quat = vec![nalgebra::UnitQuaternion::identity(); pos.len()];
     motion.targets = Some(TrackedTargets { body_names: names, pos, quat });
-    let rep = report(&motion, &model, &ReportOptions::default()).unwrap();
+    // The config's root (GMR's `robot_root_name`) names the pelvis target.
+    let opts = ReportOptions { root_target: Some("pelvis".to_owned()), ..ReportOptions::default() };
+    let rep = report(&motion, &model, &opts).unwrap();
     let t = rep.root_acceleration.target.expect("the pelvis is a target");
     assert!((t.mean_mps2 - 3.0 * G).abs() < 1e-6 && t.share_over == 1.0, "{t:?}");
+    assert_eq!(rep.root_acceleration.target_body.as_deref(), Some("pelvis"));
     assert_eq!(rep.root_acceleration.motion.mean_mps2, 0.0);
-    assert!(rep.to_string().contains("its target:  mean 29.4 m/s²"), "{rep}");
+    assert!(rep.to_string().contains("scaled human (target of pelvis): mean 29.4 m/s²"), "{rep}");
+    // Without a config, the first target (here the hand, at 100 m/s²).
+    let first = report(&motion, &model, &ReportOptions::default()).unwrap().root_acceleration;
+    assert_eq!(first.target_body.as_deref(), Some("left_wrist_yaw_link"));
+    assert!((first.target.unwrap().mean_mps2 - 100.0).abs() < 1e-6);
+    // A root that is no target: none.
+    let opts =
+        ReportOptions { root_target: Some("torso_link".to_owned()), ..ReportOptions::default() };
+    assert!(report(&motion, &model, &opts).unwrap().root_acceleration.target.is_none());
 }
 
 #[test]

@@ -39,9 +39,11 @@ pub struct RootAcceleration {
     pub threshold_mps2: f64,
     /// The robot's root, from its world position (the free joint's `qpos` translation).
     pub motion: AccelStats,
-    /// The root body's target position (the scaled human's pelvis with GMR's configs), when
-    /// the motion has targets and one of them is the root body.
+    /// The scaled human's pelvis: the target position of [`RootAcceleration::target_body`],
+    /// when the motion has targets.
     pub target: Option<AccelStats>,
+    /// The body of that target ([`super::ReportOptions::root_target`]).
+    pub target_body: Option<String>,
 }
 
 /// Mean `|q̈|` over every velocity coordinate (MuJoCo's nv), by group.
@@ -63,25 +65,34 @@ pub struct Jitter {
 }
 
 /// Root acceleration of the motion and of its root target.
+/// Root acceleration of the motion and of the target of `root_target` (the first target
+/// when `None`).
 pub(super) fn root_acceleration(
     motion: &RobotMotion,
     model: &mjcf::Model,
     poses: &BodyPoses,
+    root_target: Option<&str>,
 ) -> RootAcceleration {
     let frames = motion.num_frames();
     let robot: Vec<Vector3<f64>> = (0..frames).map(|t| poses.pos(t, 0)).collect();
     let body = model.bodies.get(1).map(|b| b.name.clone()).unwrap_or_default();
     let target = motion.targets.as_ref().and_then(|targets| {
         let k = targets.body_names.len();
-        let j = targets.body_names.iter().position(|n| *n == body)?;
+        let j = match root_target {
+            Some(name) => targets.body_names.iter().position(|n| n == name)?,
+            None if k > 0 => 0,
+            None => return None,
+        };
         let p: Vec<Vector3<f64>> = (0..frames).map(|t| targets.pos[t * k + j]).collect();
-        Some(accel_stats(&p, motion.fps))
+        Some((accel_stats(&p, motion.fps), targets.body_names[j].clone()))
     });
+    let (target, target_body) = target.unzip();
     RootAcceleration {
         body,
         threshold_mps2: 2.0 * GRAVITY,
         motion: accel_stats(&robot, motion.fps),
         target,
+        target_body,
     }
 }
 
