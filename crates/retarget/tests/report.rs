@@ -692,3 +692,45 @@ fn the_json_carries_the_new_sections() {
     assert_eq!((d["friction"].as_f64(), d["cone_edges"].as_u64()), (Some(0.8), Some(8)));
     assert!(json["dynamics_unavailable"].is_null());
 }
+
+#[test]
+fn the_needed_torque_is_the_rate_of_the_centroidal_angular_momentum() {
+    // One free body, 2 kg, principal moments (1, 2, 3) about axes turned 90° about x (the
+    // third principal axis along the body's −y), spun up about the world's y at α = 4 rad/s²
+    // while held in place: it needs its weight and the torque 3 α about y. No geoms: no
+    // contact, and L = 1 m.
+    let xml = r#"<mujoco model="spinner"><worldbody><body name="b" pos="0 0 1"><freejoint/>
+        <inertial pos="0 0 0" quat="0.7071067811865476 0.7071067811865476 0 0" mass="2" diaginertia="1 2 3"/>
+        </body></worldbody></mujoco>"#;
+    let model = mjcf::Model::from_xml_str(xml, None).unwrap();
+    let alpha = 4.0;
+    let mut qpos = Vec::new();
+    for t in 0..FRAMES {
+        let s = t as f64 / FPS;
+        let h = alpha * s * s / 4.0; // half the angle ½ α s²
+        qpos.extend([0.0, 0.0, 1.0, h.cos(), 0.0, h.sin(), 0.0]);
+    }
+    let motion = RobotMotion {
+        fps: FPS,
+        nq: model.nq,
+        qpos,
+        joint_names: vec![],
+        body_names: vec!["b".to_owned()],
+        targets: None,
+        contacts: None,
+    };
+    let frames =
+        retarget::report::dynamics_frames(&motion, &model, &ReportOptions::default()).unwrap();
+    assert_eq!(frames.len(), FRAMES - 4);
+    for d in &frames {
+        assert_eq!(d.contacts, 0);
+        assert!((d.force[2] - 2.0 * G).abs() < 1e-9 && d.force[0].abs() < 1e-9, "{d:?}");
+        assert!((d.torque[1] - 3.0 * alpha).abs() < 1e-6, "{d:?}");
+        assert!(d.torque[0].abs() < 1e-6 && d.torque[2].abs() < 1e-6, "{d:?}");
+        let expected = (1.0f64 + (3.0 * alpha / (2.0 * G)).powi(2)).sqrt();
+        assert!((d.residual - expected).abs() < 1e-6, "{} vs {expected}", d.residual);
+    }
+    let rep = report(&motion, &model, &ReportOptions::default());
+    // The report needs feet; this body has none, so only the per-frame check runs here.
+    assert!(rep.is_err());
+}
