@@ -320,8 +320,15 @@ fn units(
         positive("metres per unit", m)?;
         return Ok((m, format!("forced: {m} m per file unit")));
     }
-    if let Some(h) = humanoid.filter(|h| h.stature_path > 0.0) {
-        return Ok(size::choose_units_from_stature(h.stature_path));
+    let stature = humanoid.map(|h| h.stature_path).filter(|&p| p > 0.0);
+    if let UnitChoice::Declared(m) = choice {
+        positive("metres per unit", m)?;
+        if let Some(path) = stature {
+            return Ok(size::declared_units_from_stature(m, path));
+        }
+    }
+    if let Some(path) = stature {
+        return Ok(size::choose_units_from_stature(path));
     }
     let parents: Vec<Option<usize>> = plan.parents().collect();
     let lengths: Vec<f64> = plan
@@ -332,7 +339,11 @@ fn units(
             _ => 0.0,
         })
         .collect();
-    Ok(size::choose_units(size::tree_diameter(&parents, &lengths)))
+    let diameter = size::tree_diameter(&parents, &lengths);
+    Ok(match choice {
+        UnitChoice::Declared(m) => size::declared_units(m, diameter),
+        _ => size::choose_units(diameter),
+    })
 }
 
 /// World positions of the rest pose (all channels zero, OFFSETs only), metres.
@@ -696,6 +707,47 @@ mod tests {
         let (_, report) = human_motion(&bvh, &options).unwrap();
         assert_eq!((report.metres_per_unit, report.height), (0.5, 1.7));
         assert!(report.unit_reason.starts_with("forced"));
+    }
+
+    #[test]
+    fn a_declared_unit_holds_for_human_sizes_and_gives_way_to_proportions() {
+        let channels = tpose(Vec::new()).skeleton.num_channels();
+        let mut heights = Vec::new();
+        for scale in [1.0, 1.0 / 3.0, 2.7] {
+            // A 1.8 m figure (cm), a 0.6 m one and a 4.9 m one, all declared centimetres.
+            let mut bvh = tpose(vec![still(channels, [0.0, 95.0 * scale, 0.0])]);
+            bvh.skeleton
+                .joints
+                .iter_mut()
+                .for_each(|j| j.offset.iter_mut().for_each(|v| *v *= scale));
+            let options = FkOptions { units: UnitChoice::Declared(0.01), ..FkOptions::default() };
+            let (_, report) = human_motion(&bvh, &options).unwrap();
+            let kind = if scale == 1.0 { "declared" } else { "scaled" };
+            assert!(report.unit_reason.starts_with(kind), "{}", report.unit_reason);
+            if scale == 1.0 {
+                assert_eq!(report.metres_per_unit, 0.01);
+            } else {
+                // Scaled by the proportions: the same size whatever the file's size.
+                heights.push((report.height, report.metres_per_unit * scale));
+            }
+        }
+        assert!((heights[0].0 - heights[1].0).abs() < 1e-9, "{heights:?}");
+        assert!((heights[0].1 - heights[1].1).abs() < 1e-12, "{heights:?}");
+        assert!((1.5..2.1).contains(&heights[0].0), "{heights:?}");
+    }
+
+    #[test]
+    fn axis_conventions_from_matrices_are_the_named_ones_when_they_equal_them() {
+        for axes in [AxisConvention::YUp, AxisConvention::ZUp, AxisConvention::YUpFaceX] {
+            assert_eq!(AxisConvention::from_matrix(&axes.world_from_file_matrix()), Some(axes));
+        }
+        let q = UnitQuaternion::from_euler_angles(0.3, -1.2, 2.0);
+        let m = q.to_rotation_matrix().into_inner();
+        match AxisConvention::from_matrix(&m) {
+            Some(AxisConvention::Custom(c)) => assert!(c.angle_to(&q) < 1e-12),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(AxisConvention::from_matrix(&-Matrix3::identity()), None, "a mirror");
     }
 
     #[test]

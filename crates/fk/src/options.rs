@@ -30,6 +30,22 @@ pub enum AxisConvention {
 }
 
 impl AxisConvention {
+    /// The convention of a world-from-file rotation matrix: the named variant it equals
+    /// exactly (so that positions are permuted without rounding), else [`AxisConvention::Custom`].
+    /// `None` when `m` is not a rotation.
+    #[must_use]
+    pub fn from_matrix(m: &Matrix3<f64>) -> Option<AxisConvention> {
+        let orthonormal = (m * m.transpose() - Matrix3::identity()).amax() < 1e-9;
+        if !(orthonormal && (m.determinant() - 1.0).abs() < 1e-9) {
+            return None;
+        }
+        let named = [AxisConvention::YUp, AxisConvention::ZUp, AxisConvention::YUpFaceX];
+        Some(named.into_iter().find(|a| a.world_from_file_matrix() == *m).unwrap_or_else(|| {
+            let r = nalgebra::Rotation3::from_matrix_unchecked(*m);
+            AxisConvention::Custom(UnitQuaternion::from_rotation_matrix(&r))
+        }))
+    }
+
     /// World-from-file rotation as a matrix, exact (entries 0 and ±1) for the named variants so
     /// that positions are permuted without rounding, as GMR's `p @ R.T` does.
     #[must_use]
@@ -74,6 +90,11 @@ pub enum UnitChoice {
     Auto,
     /// Metres per file unit (0.01 for centimetres).
     Scale(f64),
+    /// The unit the file declares (FBX's `UnitScaleFactor`), in metres per file unit: used
+    /// when the figure is a human size in it, else the figure is scaled by its proportions to
+    /// a typical human, as [`UnitChoice::Auto`] does when no unit fits (a 0.6 m or a 4.9 m
+    /// game character retargets as a human-sized one).
+    Declared(f64),
 }
 
 /// A body that is not a skeleton joint but combines two: GMR's `LeftFootMod` is the position

@@ -68,6 +68,53 @@ pub(crate) fn choose_units_from_stature(path: f64) -> (f64, String) {
     choose(Proxy { value: path, range: (0.8, 2.4), typical: 1.6, what: "head-to-ankle bone path" })
 }
 
+/// Metres per file unit for a recognised humanoid in a file that declares its unit
+/// (`metres` per unit): that unit when the stature path is a human size in it, else a scale
+/// making the path typical ([`choose_units_from_stature`]'s range and typical value).
+#[must_use]
+pub(crate) fn declared_units_from_stature(metres: f64, path: f64) -> (f64, String) {
+    declared(
+        metres,
+        Proxy { value: path, range: (0.8, 2.4), typical: 1.6, what: "head-to-ankle bone path" },
+    )
+}
+
+/// [`declared_units_from_stature`] for a skeleton of unknown shape ([`choose_units`]'s proxy).
+#[must_use]
+pub(crate) fn declared_units(metres: f64, diameter: f64) -> (f64, String) {
+    declared(
+        metres,
+        Proxy {
+            value: diameter,
+            range: (1.0, 2.6),
+            typical: 1.8,
+            what: "longest bone path (head-to-toe / arm span)",
+        },
+    )
+}
+
+fn declared(metres: f64, proxy: Proxy) -> (f64, String) {
+    let Proxy { value, range, typical, what } = proxy;
+    let size = value * metres;
+    if !(size.is_finite() && size > 0.0) {
+        return (metres, format!("declared: {metres} m/unit ({what} gives no size to go by)"));
+    }
+    if (range.0..=range.1).contains(&size) {
+        return (
+            metres,
+            format!("declared: {what} is {size:.2} m at {metres} m/unit, a human size"),
+        );
+    }
+    let m = typical / value;
+    (
+        m,
+        format!(
+            "scaled: {what} is {size:.2} m at the declared {metres} m/unit, not a human size; \
+             scaled by its proportions to {typical} m ({m:.6} m/unit)"
+        ),
+    )
+}
+
 /// The candidate whose result is closest (in ratio) to the typical value, among those in the
 /// human range. If none fits, a computed scale making the proxy typical. Returns the scale
 /// and the reason.
