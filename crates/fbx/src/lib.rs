@@ -80,7 +80,7 @@ impl Fbx {
         if loaded.info.world_from_file().is_none() {
             return Err(Error::Axes { file: file.to_owned(), axes: loaded.info.axes.to_string() });
         }
-        let rest = scene::rest_rotations(&loaded.scene, &loaded.node_ids);
+        let (rest, _from_bind) = scene::rest_rotations(&loaded.scene, &loaded.node_ids);
         Ok(Fbx {
             scene: loaded.scene,
             file: file.to_owned(),

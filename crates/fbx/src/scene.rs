@@ -371,14 +371,35 @@ pub(crate) fn matrix(m: &ufbx::Matrix) -> Matrix4<f64> {
     )
 }
 
-/// The static (unanimated) world rotation of each skeleton node: the pose the file stores,
-/// which the BVH's zero pose reproduces.
-pub(crate) fn rest_rotations(scene: &ufbx::Scene, ids: &[usize]) -> Vec<UnitQuaternion<f64>> {
-    ids.iter()
+/// The rest rotation of each skeleton node, which the BVH's zero pose reproduces: its world
+/// rotation in the file's bind pose (the pose a skinned character was bound in, usually a
+/// T- or A-pose), else the node's static transform (the properties without animation, which
+/// exporters often write at the current frame). Returns how many came from a bind pose.
+pub(crate) fn rest_rotations(
+    scene: &ufbx::Scene,
+    ids: &[usize],
+) -> (Vec<UnitQuaternion<f64>>, usize) {
+    let mut bind: BTreeMap<usize, Matrix4<f64>> = BTreeMap::new();
+    for pose in scene.poses.iter().filter(|p| p.is_bind_pose) {
+        for bone in pose.bone_poses.iter() {
+            bind.entry(bone.bone_node.element.typed_id as usize)
+                .or_insert_with(|| matrix(&bone.bone_to_world));
+        }
+    }
+    let mut from_bind = 0;
+    let rotations = ids
+        .iter()
         .map(|&id| {
-            scene.nodes.get(id).map_or_else(UnitQuaternion::identity, |n| {
-                math::rotation(&matrix(&n.node_to_world))
-            })
+            let m = match (bind.get(&id), scene.nodes.get(id)) {
+                (Some(m), _) => {
+                    from_bind += 1;
+                    *m
+                }
+                (None, Some(n)) => matrix(&n.node_to_world),
+                (None, None) => Matrix4::identity(),
+            };
+            math::rotation(&m)
         })
-        .collect()
+        .collect();
+    (rotations, from_bind)
 }

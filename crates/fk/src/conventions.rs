@@ -2,10 +2,12 @@
 //!
 //! A convention lists, per body part, the joint names it uses. Sided parts write the side as
 //! a placeholder that stands for both sides: `{Left}` (`Left`/`Right`), `{left}`
-//! (`left`/`right`), `{L}` (`L`/`R`), `{l}` (`l`/`r`). Names are compared after
-//! [`normalise`]: namespace (`mixamorig:`) and exporter prefixes (`mixamorig_`, `DEF-`,
-//! `Bip01 `, Xsens' `j`) removed, case and separators ignored. So `Bip01 L Thigh`, `L Thigh`
-//! and `l_thigh` are the same name.
+//! (`left`/`right`), `{L}` (`L`/`R`), `{l}` (`l`/`r`), and French `{gauche}`
+//! (`gauche`/`droit`) and `{gauche_f}` (`gauche`/`droite`, for feminine nouns). Names are
+//! compared after [`normalise`]: namespace (`mixamorig:`) and exporter prefixes
+//! (`mixamorig_`, `DEF-`, `Bip01 `, Xsens' `j`) removed, case, accents and separators
+//! ignored. So `Bip01 L Thigh`, `L Thigh` and `l_thigh` are the same name, and so are `tête`
+//! and `Tete`.
 //!
 //! Names only choose among what the hierarchy allows ([`crate::recognise`]): the same name means
 //! different parts in different conventions (`LeftShoulder` is the clavicle in Mixamo and the
@@ -270,6 +272,26 @@ pub const CONVENTIONS: &[Convention] = &[
         ],
     },
     Convention {
+        name: "French (Blender rigs)",
+        source: "hand-made French rigs, as the Blender barbarian of ufbx's test files \
+                 (bassin, torse, tête, bras droit, main droite, jambe gauche, pied gauche)",
+        parts: &[
+            (Pelvis, &["bassin", "hanches"]),
+            (Spine, &["colonne", "dos", "ventre"]),
+            (Chest, &["torse", "poitrine", "thorax"]),
+            (Neck, &["cou"]),
+            (Head, &["tête"]),
+            (Clavicle, &["clavicule {gauche_f}", "épaule {gauche_f}"]),
+            (UpperArm, &["bras {gauche}"]),
+            (Forearm, &["avant-bras {gauche}", "coude {gauche}"]),
+            (Hand, &["main {gauche_f}", "poignet {gauche}"]),
+            (Thigh, &["cuisse {gauche_f}", "jambe {gauche_f}"]),
+            (Shin, &["tibia {gauche}", "mollet {gauche}", "genou {gauche}"]),
+            (Foot, &["pied {gauche}", "cheville {gauche_f}"]),
+            (Toe, &["orteils {gauche}", "orteil {gauche}"]),
+        ],
+    },
+    Convention {
         name: "plain anatomical names",
         source: "hand-made and game skeletons (pelvis, clavicle, upperarm, lowerarm, calf)",
         parts: &[
@@ -291,11 +313,14 @@ pub const CONVENTIONS: &[Convention] = &[
 ];
 
 /// Words that mark a joint as no part of the body's chains: twist and roll helpers, IK
-/// targets, props. Joints whose name has one of these as a word are skipped when the
-/// recogniser walks down a limb (fingers, face and other side branches are told apart by
-/// the hierarchy instead).
-pub const IGNORED_WORDS: &[&str] =
-    &["twist", "roll", "ik", "prop", "weapon", "sword", "gun", "helper", "holster", "attach"];
+/// targets and rig controls (exported as bones by Maya rigs: `HipsCtrl`, `LeftFootCtrl`,
+/// `LeftKneePole`), props (`arme droite`: French for weapon). Joints whose name has one of
+/// these as a word are skipped when the recogniser walks down a limb (fingers, face and
+/// other side branches are told apart by the hierarchy instead).
+pub const IGNORED_WORDS: &[&str] = &[
+    "twist", "roll", "ik", "ctrl", "control", "pole", "prop", "weapon", "sword", "gun", "arme",
+    "helper", "holster", "attach",
+];
 
 /// Exporter prefixes removed before comparing names (after the namespace, `mixamorig:`).
 const PREFIXES: &[&str] = &[
@@ -312,11 +337,11 @@ const PREFIXES: &[&str] = &[
 
 /// A joint name reduced for comparison: the part after the last `:` (namespaces), without
 /// an exporter prefix (`mixamorig_`, `DEF-`, `Bip01 `, `CC_Base_`, Xsens' `j` before a
-/// capital), lowercase, letters and digits only.
+/// capital), lowercase, accents removed ([`fold`]), letters and digits only.
 #[must_use]
 pub fn normalise(name: &str) -> String {
     let name = name.rsplit(':').next().unwrap_or(name);
-    let lower = name.to_ascii_lowercase();
+    let lower: String = name.chars().flat_map(char::to_lowercase).map(fold).collect();
     let mut rest: &str = &lower;
     for prefix in PREFIXES {
         if let Some(stripped) = rest.strip_prefix(prefix) {
@@ -336,6 +361,21 @@ pub fn normalise(name: &str) -> String {
     rest.chars().filter(char::is_ascii_alphanumeric).collect()
 }
 
+/// A lowercase Latin letter without its accent (`ê` → `e`, `ç` → `c`); others unchanged.
+fn fold(c: char) -> char {
+    match c {
+        'à' | 'á' | 'â' | 'ã' | 'ä' | 'å' => 'a',
+        'ç' => 'c',
+        'è' | 'é' | 'ê' | 'ë' => 'e',
+        'ì' | 'í' | 'î' | 'ï' => 'i',
+        'ñ' => 'n',
+        'ò' | 'ó' | 'ô' | 'õ' | 'ö' | 'ø' => 'o',
+        'ù' | 'ú' | 'û' | 'ü' => 'u',
+        'ý' | 'ÿ' => 'y',
+        other => other,
+    }
+}
+
 /// A name pattern with its side placeholder filled in for `side` (the pattern as given when
 /// it has none).
 #[must_use]
@@ -349,6 +389,8 @@ pub fn instantiate(pattern: &str, side: Option<Side>) -> String {
         .replace("{left}", &fill("left", "right"))
         .replace("{L}", &fill("L", "R"))
         .replace("{l}", &fill("l", "r"))
+        .replace("{gauche_f}", &fill("gauche", "droite"))
+        .replace("{gauche}", &fill("gauche", "droit"))
 }
 
 /// A name match: which role a convention gives the name, and how well (the index of the
@@ -395,8 +437,8 @@ pub(crate) fn side_of(name: &str, normalised_matches: &[NameMatch]) -> Option<Si
     let name = name.rsplit(':').next().unwrap_or(name);
     let words = words(name);
     let side = |w: &str| match w.to_ascii_lowercase().as_str() {
-        "left" | "l" => Some(Side::Left),
-        "right" | "r" => Some(Side::Right),
+        "left" | "l" | "gauche" => Some(Side::Left),
+        "right" | "r" | "droit" | "droite" => Some(Side::Right),
         _ => None,
     };
     let first = words.first().and_then(|w| side(w));
@@ -476,6 +518,32 @@ mod tests {
         assert_eq!(normalise("jLeftHip"), "lefthip");
         assert_eq!(normalise("joint12"), "joint12");
         assert_eq!(normalise("spine_01"), "spine01");
+        assert_eq!(normalise("tête"), "tete");
+        assert_eq!(normalise("TÊTE"), "tete");
+        assert_eq!(normalise("bras droit"), "brasdroit");
+    }
+
+    #[test]
+    fn fbx_rigs_are_named() {
+        let roles = |name: &str| -> Vec<Role> {
+            matches(&normalise(name)).into_iter().map(|m| m.role).collect()
+        };
+        assert!(roles("mixamorig:LeftUpLeg").contains(&Role::LeftThigh));
+        assert!(roles("Bip01 L Thigh").contains(&Role::LeftThigh));
+        assert!(roles("Lefthand").contains(&Role::LeftHand), "Lefthand as LeftHand");
+        assert!(roles("tête").contains(&Role::Head));
+        assert!(roles("bras droit").contains(&Role::RightUpperArm));
+        assert!(roles("main droite").contains(&Role::RightHand));
+        assert!(roles("jambe gauche").contains(&Role::LeftThigh));
+        assert!(roles("pied gauche").contains(&Role::LeftFoot));
+        let side = |n: &str| side_of(n, &matches(&normalise(n)));
+        assert_eq!(side("arme droite"), Some(Side::Right));
+        assert_eq!(side("pagne avant"), None);
+        for control in ["HipsCtrl", "LeftFootCtrl", "LeftFootIK", "LeftKneePole", "arme droite"] {
+            assert!(is_ignored(control), "{control}");
+        }
+        assert!(!is_ignored("Armature"));
+        assert!(!is_ignored("LeftArm"));
     }
 
     #[test]

@@ -37,6 +37,7 @@ mod motion;
 mod options;
 mod roles;
 mod size;
+mod straight;
 mod structure;
 mod trig;
 
@@ -48,6 +49,7 @@ pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
 pub use roles::{
     Humanoid, Part, Reference, RestPose, Role, RoleJoint, RoleMap, Rule, Side, UpAxis,
 };
+pub use straight::straighten_limbs;
 
 use std::collections::BTreeMap;
 

@@ -864,9 +864,14 @@ fn rest_pose(key: &Key, rest: &[Vector3<f64>], up: UpAxis) -> (RestPose, String)
                 a.vector().dot(&v).total_cmp(&b.vector().dot(&v))
             })
             .unwrap_or(up);
+        let what = if trunk < UPRIGHT_COS {
+            format!("pelvis → head points along {axis}, not {up}")
+        } else {
+            format!("the legs do not hang along {up}")
+        };
         return (
             RestPose::NotUpright,
-            format!("in the zero pose pelvis → head points along {axis}, not {up}: the zero pose is not used"),
+            format!("in the zero pose {what}: the zero pose is not used"),
         );
     }
     let elevation = [0, 1].map(|s| {

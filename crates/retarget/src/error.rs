@@ -64,6 +64,10 @@ pub enum Error {
     /// A C3D file that does not parse.
     #[error(transparent)]
     C3d(#[from] c3d::Error),
+    /// An FBX file that cannot be read, or a take that cannot be sampled (the message names
+    /// the file and the take).
+    #[error(transparent)]
+    Fbx(#[from] fbx::Error),
     /// A robot model (MJCF or URDF) that does not compile.
     #[error(transparent)]
     Mjcf(#[from] mjcf::Error),

@@ -74,6 +74,7 @@ pub mod constraints;
 pub mod contact;
 pub mod derive;
 mod error;
+pub mod fbx_clip;
 pub mod feet;
 pub mod gmr;
 pub mod joint_speed;
@@ -94,6 +95,7 @@ pub mod writers;
 
 pub use config::{IkConfig, MatchEntry};
 pub use error::Error;
+pub use fbx_clip::FbxClip;
 pub use marker_config::MarkerConfig;
 pub use motion::{FootContacts, RobotMotion, TrackedTargets};
 pub use pipeline::{

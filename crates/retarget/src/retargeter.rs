@@ -31,6 +31,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
 use crate::derive::Chosen;
+use crate::fbx_clip::FbxClip;
 use crate::lie::Pose;
 use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
@@ -300,6 +301,51 @@ impl Retargeter {
         self.retarget_bvh(&bvh::from_path(path)?)
     }
 
+    /// The config an FBX take is retargeted with, and why: [`Retargeter::choose_config`] of
+    /// its skeleton, with the file's axes and unit ([`FbxClip::fk_options`]).
+    pub fn choose_fbx_config(&self, clip: &FbxClip) -> Result<Chosen, Error> {
+        let gmr = self.options.mode == SolveMode::Gmr;
+        let fk = clip.fk_options(&self.options.fk);
+        let (given, tuned) = (self.given.clone(), self.tuned.as_ref());
+        crate::derive::choose(&self.model, &self.label, &clip.bvh, &fk, given, tuned, gmr)
+    }
+
+    /// Retargets an FBX take as a BVH clip ([`Retargeter::retarget_bvh`]) with the file's
+    /// axes and unit; `diag.human_inferred` starts with the take and what the file declares
+    /// ([`FbxClip::summary`]) and ends with the config used.
+    pub fn retarget_fbx_with(
+        &self,
+        clip: &FbxClip,
+        chosen: &Chosen,
+    ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+        let options =
+            RetargetOptions { fk: clip.fk_options(&self.options.fk), ..self.options.clone() };
+        let (motion, mut diag) =
+            crate::pipeline::retarget_bvh(&clip.bvh, &self.model, &chosen.config, &options)?;
+        diag.human_inferred = [clip.summary(), diag.human_inferred, chosen.summary.clone()]
+            .into_iter()
+            .filter(|s| !s.is_empty())
+            .collect::<Vec<_>>()
+            .join("; ");
+        Ok((motion, diag))
+    }
+
+    /// Take `take` (name or index; `None`: the one with the most motion) of the FBX file at
+    /// `path`, retargeted with [`Retargeter::choose_fbx_config`]'s config.
+    pub fn retarget_fbx_file(
+        &self,
+        path: &Path,
+        take: Option<&str>,
+    ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+        let clip = FbxClip::read(path, take)?;
+        let in_file = |e: Error| match e {
+            e @ Error::InFile { .. } => e,
+            e => Error::InFile { path: clip.file.clone(), source: Box::new(e) },
+        };
+        let chosen = self.choose_fbx_config(&clip).map_err(in_file)?;
+        self.retarget_fbx_with(&clip, &chosen).map_err(in_file)
+    }
+
     /// Retargets a human motion with [`Retargeter::motion_config`]; the subject height is the
     /// options' or the config's `human_height_assumption` (GMR without `actual_human_height`).
     pub fn retarget(&self, human: &HumanMotion) -> Result<(RobotMotion, ClipDiagnostics), Error> {
@@ -425,8 +471,9 @@ impl Retargeter {
         }
     }
 
-    /// Retargets BVH files in parallel on a pool of `threads` threads (0: one per core): each
-    /// `(input, output)` pair is read, retargeted ([`Retargeter::retarget_bvh`]) and written
+    /// Retargets BVH and FBX files in parallel on a pool of `threads` threads (0: one per
+    /// core): each `(input, output)` pair is read, retargeted ([`Retargeter::retarget_bvh`];
+    /// an FBX file's take with the most motion, [`Retargeter::retarget_fbx_file`]) and written
     /// in the output's format (by extension). One result per pair, in order; a clip that fails
     /// fails alone.
     pub fn retarget_files(
@@ -448,11 +495,14 @@ impl Retargeter {
         let started = std::time::Instant::now();
         let in_file =
             |e: Error| Error::InFile { path: input.display().to_string(), source: Box::new(e) };
-        let is_bvh = input.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
-        if !is_bvh {
-            return Err(in_file(Error::InvalidOption("not a .bvh file".to_owned())));
-        }
-        let (motion, diag) = self.retarget_bvh_file(input).map_err(in_file)?;
+        let is = |ext: &str| input.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
+        let (motion, diag) = if is("bvh") {
+            self.retarget_bvh_file(input).map_err(in_file)?
+        } else if is("fbx") {
+            self.retarget_fbx_file(input, None)?
+        } else {
+            return Err(in_file(Error::InvalidOption("not a .bvh or .fbx file".to_owned())));
+        };
         self.write(&motion, output, None)?;
         Ok(FileResult {
             frames: motion.num_frames(),

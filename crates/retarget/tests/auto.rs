@@ -59,12 +59,23 @@ struct Checks {
 }
 
 fn run(model: &mjcf::Model, robot: &str, bvh: &bvh::Bvh, tuned: Option<&IkConfig>) -> Checks {
-    let fk_options = fk::FkOptions::default();
-    let chosen = derive::choose(model, robot, bvh, &fk_options, None, tuned, false)
+    run_with(model, robot, bvh, tuned, &RetargetOptions::default())
+}
+
+/// [`run`] with other options (FK options for an FBX file's axes and unit, `--gmr`).
+fn run_with(
+    model: &mjcf::Model,
+    robot: &str,
+    bvh: &bvh::Bvh,
+    tuned: Option<&IkConfig>,
+    options: &RetargetOptions,
+) -> Checks {
+    let fk_options = options.fk.clone();
+    let gmr = options.mode == retarget::SolveMode::Gmr;
+    let chosen = derive::choose(model, robot, bvh, &fk_options, None, tuned, gmr)
         .unwrap_or_else(|e| panic!("{robot}: {e}"));
-    let (motion, _) =
-        retarget::retarget_bvh(bvh, model, &chosen.config, &RetargetOptions::default())
-            .unwrap_or_else(|e| panic!("{robot}: {e}"));
+    let (motion, _) = retarget::retarget_bvh(bvh, model, &chosen.config, options)
+        .unwrap_or_else(|e| panic!("{robot}: {e}"));
     let (human, report) = fk::human_motion(bvh, &fk_options).unwrap();
     let humanoid = report.humanoid.unwrap();
     let roles = RobotRoles::recognise(model).unwrap();
@@ -268,6 +279,44 @@ fn every_shared_bvh_onto_the_g1_and_the_t1() {
             assert_sane(&format!("{name} → {key}"), &checks, walk);
             let expect_tuned = name.starts_with("lafan1");
             assert_eq!(checks.choice == Choice::Tuned, expect_tuned, "{name} → {key}");
+        }
+    }
+}
+
+/// Issue 33: the four shared FBX files (MotionBuilder, Maya rig controls, the one-bone-per-
+/// limb Blender barbarian with straight limbs, the 0.63 m XNA dude), their default take, onto
+/// the G1 and the T1 with no config, in both solves.
+#[test]
+fn every_shared_fbx_onto_the_g1_and_the_t1_in_both_solves() {
+    let Some(dir) = shared::shared_file("data/fbx") else { return };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "fbx"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4, "{files:?}");
+    for key in ["unitree_g1", "booster_t1_29dof"] {
+        let model = shipped_model(key);
+        let tuned = tuned(key);
+        for file in &files {
+            let name = file.file_name().unwrap().to_string_lossy().into_owned();
+            let clip = retarget::FbxClip::read(file, None).unwrap();
+            for mode in [retarget::SolveMode::default(), retarget::SolveMode::Gmr] {
+                let options = RetargetOptions {
+                    fk: clip.fk_options(&fk::FkOptions::default()),
+                    mode: mode.clone(),
+                    ..RetargetOptions::default()
+                };
+                let checks = run_with(&model, key, &clip.bvh, tuned.as_ref(), &options);
+                let what = format!(
+                    "{name} → {key} ({})",
+                    if mode == retarget::SolveMode::Gmr { "--gmr" } else { "default" }
+                );
+                assert_sane(&what, &checks, false);
+                assert_eq!(checks.choice, Choice::Derived, "{what}");
+                assert!(checks.contact.is_some(), "{what}: no source contacts");
+            }
         }
     }
 }
