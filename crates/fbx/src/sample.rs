@@ -16,7 +16,7 @@
 //! offsets: the world positions of every joint are kept exactly.
 
 use bvh::{Axis, Bvh, Channel, Joint, JointId, JointKind, Motion, Skeleton};
-use nalgebra::{Matrix4, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Matrix4, UnitQuaternion, Vector3};
 
 use crate::{math, scene, Error, Fbx};
 
@@ -94,6 +94,32 @@ impl Fbx {
     /// Take `take` sampled at its frames ([`crate::TakeInfo::frames`]) as a BVH in the file's
     /// axes and units (module docs). A take without keys, or without a frame, is an error.
     pub fn bvh(&self, take: usize) -> Result<Bvh, Error> {
+        self.bvh_turned(take, None)
+    }
+
+    /// [`Fbx::bvh`] in BVH's usual axes: Y up, the front (towards the viewer) +Z, right +X,
+    /// whatever the file's axis system (the same numbers for a Y-up file); file units.
+    pub fn bvh_y_up(&self, take: usize) -> Result<Bvh, Error> {
+        let world = self.info.world_from_file().ok_or_else(|| Error::Axes {
+            file: self.file.clone(),
+            axes: self.info.axes.to_string(),
+        })?;
+        // BVH Y up → our world is (x, y, z) ↦ (x, −z, y); its inverse after the file's.
+        let y_up = Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 0.0) * world;
+        let identity = (y_up - Matrix3::identity()).amax() < 1e-12;
+        self.bvh_turned(take, (!identity).then_some(y_up))
+    }
+
+    /// The BVH with every world transform turned by `turn` first (`None`: as in the file).
+    fn bvh_turned(&self, take: usize, turn: Option<Matrix3<f64>>) -> Result<Bvh, Error> {
+        let (turn4, turn_q) = match turn {
+            Some(m) => {
+                let r = nalgebra::Rotation3::from_matrix_unchecked(m);
+                (Some(m.to_homogeneous()), UnitQuaternion::from_rotation_matrix(&r))
+            }
+            None => (None, UnitQuaternion::identity()),
+        };
+        let rest: Vec<UnitQuaternion<f64>> = self.rest.iter().map(|b| turn_q * b).collect();
         let times = self.frame_times(take)?;
         let n = self.node_ids.len();
         // Per frame and node: offset (3) and Euler angles in degrees (3).
@@ -104,9 +130,12 @@ impl Fbx {
         let mut previous: Vec<Option<[f64; 3]>> = vec![None; n];
         for &t in &times {
             self.world_at(take, t, &mut world)?;
+            if let Some(turn) = &turn4 {
+                world.iter_mut().for_each(|m| *m = turn * *m);
+            }
             q.clear();
             p.clear();
-            for (m, rest) in world.iter().zip(&self.rest) {
+            for (m, rest) in world.iter().zip(&rest) {
                 q.push(math::rotation(m) * rest.inverse());
                 p.push(math::translation(m));
             }
