@@ -13,8 +13,9 @@ use crate::batch::{self, ClipResult, Plan, Shard, Summary};
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
-    /// Directory tree of BVH (and C3D) files; relative paths are mirrored into the output
-    /// directory. Required unless --merge-summaries.
+    /// Directory tree of BVH, FBX (each file's take with the most motion) and C3D files;
+    /// relative paths are mirrored into the output directory. Required unless
+    /// --merge-summaries.
     #[arg(value_name = "IN_DIR", required_unless_present = "merge_summaries")]
     pub input: Option<PathBuf>,
     /// Robot (required unless --merge-summaries): a shipped name (see `retarget robots`) or a
@@ -97,7 +98,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     };
     let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;
     job.fps = args.fps;
-    let files = batch::select_shard(batch::walk(&input, &["bvh", "c3d"])?, args.shard);
+    let files = batch::select_shard(batch::walk(&input, &["bvh", "fbx", "c3d"])?, args.shard);
     let jobs =
         args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     eprintln!(
@@ -194,9 +195,21 @@ impl Job {
     /// what was inferred about the source.
     fn convert_file(&self, src: &Path, dst: &Path) -> anyhow::Result<ClipResult> {
         remove_stale_temporaries(dst);
-        let is_c3d = src.extension().is_some_and(|e| e.eq_ignore_ascii_case("c3d"));
-        let (motion, diag, config) = if is_c3d {
+        let is = |ext: &str| src.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext));
+        let (motion, diag, config) = if is("c3d") {
             self.convert_c3d(src)?
+        } else if is("fbx") {
+            // An FBX file: its take with the most motion (the summary's `inferred` says which).
+            let clip = retarget::FbxClip::read(src, None)?;
+            let chosen = self
+                .retargeter
+                .choose_fbx_config(&clip)
+                .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+            let (motion, diag) = self
+                .retargeter
+                .retarget_fbx_with(&clip, &chosen)
+                .with_context(|| format!("{}: retargeting", src.display()))?;
+            (motion, diag, chosen.config)
         } else {
             let bvh = bvh::from_path(src)?;
             let chosen = self

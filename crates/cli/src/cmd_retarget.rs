@@ -1,5 +1,6 @@
 //! The main job: `retarget --bvh FILE --robot NAME [-o OUT] [--config C] [--human-height H]`,
-//! or `retarget --c3d FILE --config MARKER_CONFIG --robot NAME ...` (marker-driven).
+//! `retarget --fbx FILE [--take NAME|N] --robot NAME ...` (`cmd_fbx`), or
+//! `retarget --c3d FILE --config MARKER_CONFIG --robot NAME ...` (marker-driven).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -14,9 +15,17 @@ use retarget::{
 
 #[derive(Args, Debug)]
 pub struct MainArgs {
-    /// BVH motion capture file to retarget (this or --c3d is required).
-    #[arg(long, value_name = "FILE", required_unless_present = "c3d")]
+    /// BVH motion capture file to retarget (this, --fbx or --c3d is required).
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["c3d", "fbx"])]
     pub bvh: Option<PathBuf>,
+    /// FBX file to retarget (Mixamo, MotionBuilder, Maya, 3ds Max, Blender exports): one take,
+    /// see --take.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["bvh", "c3d"])]
+    pub fbx: Option<PathBuf>,
+    /// The FBX take: its name or its index in `retarget fbx info` (default: the take with the
+    /// most motion; the output says which).
+    #[arg(long, value_name = "NAME|N", requires = "fbx")]
+    pub take: Option<String>,
     /// C3D marker file to retarget (instead of --bvh); needs a marker config (--config)
     /// with `marker_bodies`, e.g. configs/c3d_plugingait_to_unitree_g1.json.
     #[arg(long, value_name = "FILE", conflicts_with = "bvh", requires = "config")]
@@ -82,10 +91,10 @@ pub fn shipped_config(key: &str) -> Option<anyhow::Result<IkConfig>> {
 }
 
 pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
-    let input = args.bvh.clone().or_else(|| args.c3d.clone());
+    let input = args.bvh.clone().or_else(|| args.fbx.clone()).or_else(|| args.c3d.clone());
     let (Some(input), Some(robot)) = (input, args.robot.clone()) else {
         eprintln!(
-            "usage: retarget --bvh FILE | --c3d FILE --config C --robot NAME [-o OUT]   (see `retarget --help`)"
+            "usage: retarget --bvh FILE | --fbx FILE | --c3d FILE --config C --robot NAME [-o OUT]   (see `retarget --help`)"
         );
         return Ok(ExitCode::from(2));
     };
@@ -118,14 +127,18 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         if let Some(path) = &args.config {
             retargeter = retargeter.with_config(IkConfig::from_file(path)?);
         }
-        let bvh =
-            crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
-        let chosen = retargeter
-            .choose_config(&bvh)
-            .with_context(|| format!("{}: choosing the IK config", input.display()))?;
-        retargeter
-            .retarget_bvh_with(&bvh, &chosen)
-            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
+        if args.fbx.is_some() {
+            crate::cmd_fbx::retarget(&retargeter, &input, args.take.as_deref(), &robot)?
+        } else {
+            let bvh =
+                crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
+            let chosen = retargeter
+                .choose_config(&bvh)
+                .with_context(|| format!("{}: choosing the IK config", input.display()))?;
+            retargeter
+                .retarget_bvh_with(&bvh, &chosen)
+                .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
+        }
     };
     let model = retargeter.model();
     match args.fps {

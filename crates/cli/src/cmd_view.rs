@@ -1,5 +1,5 @@
 //! `retarget view`: one self-contained HTML file (WebGL player and plots) for a robot motion
-//! (`.npz`, drawn on its MJCF model) or a BVH file (the skeleton alone).
+//! (`.npz`, drawn on its MJCF model) or a BVH or FBX file (the skeleton alone).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -10,13 +10,14 @@ use crate::view::{sources, PointFigure, Scene};
 
 #[derive(clap::Args, Debug)]
 pub struct ViewArgs {
-    /// A robot motion (`.npz`) or a BVH file (skeleton only).
+    /// A robot motion (`.npz`), or a BVH or FBX file (skeleton only; an FBX file's take with
+    /// the most motion).
     pub input: PathBuf,
     /// Robot of an `.npz` motion: a shipped robot name or an MJCF path (default: the robot
     /// named in the file).
     #[arg(long)]
     pub robot: Option<String>,
-    /// The BVH the motion was retargeted from, drawn beside the robot.
+    /// The BVH or FBX file the motion was retargeted from, drawn beside the robot.
     #[arg(long)]
     pub source: Option<PathBuf>,
     /// Output HTML file (default: the input with the extension `.html`).
@@ -28,15 +29,15 @@ pub fn run(args: ViewArgs) -> anyhow::Result<ExitCode> {
     let output = args.output.clone().unwrap_or_else(|| args.input.with_extension("html"));
     let ext = args.input.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let scene = match ext.as_str() {
-        "bvh" => {
+        "bvh" | "fbx" => {
             if args.robot.is_some() || args.source.is_some() {
-                bail!("--robot and --source apply to a robot motion (.npz), not to a BVH file");
+                bail!("--robot and --source apply to a robot motion (.npz), not to a {ext} file");
             }
             bvh_scene(&args.input)?
         }
         "npz" => robot_scene(&args)?,
         _ => bail!(
-            "{}: cannot view this file: expected a .npz robot motion or a .bvh file",
+            "{}: cannot view this file: expected a .npz robot motion, a .bvh or an .fbx file",
             args.input.display()
         ),
     };
@@ -53,18 +54,28 @@ fn file_name(path: &Path) -> String {
         .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
 }
 
-/// A BVH read and converted to our world (metres, Z up) by `fk`.
+/// A BVH (or an FBX file's take) read and converted to our world (metres, Z up) by `fk`.
 struct Human {
     bvh: bvh::Bvh,
     motion: fk::HumanMotion,
     report: fk::FkReport,
+    /// An FBX file's take and what the file declares ([`retarget::FbxClip::summary`]).
+    take: Option<String>,
 }
 
 fn read_human(path: &Path) -> anyhow::Result<Human> {
-    let bvh = bvh::from_path(path)?;
-    let (motion, report) = fk::human_motion(&bvh, &fk::FkOptions::default())
+    let is_fbx = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("fbx"));
+    let (bvh, options, take) = if is_fbx {
+        let clip = retarget::FbxClip::read(path, None)?;
+        let options = clip.fk_options(&fk::FkOptions::default());
+        let take = clip.summary();
+        (clip.bvh, options, Some(take))
+    } else {
+        (bvh::from_path(path)?, fk::FkOptions::default(), None)
+    };
+    let (motion, report) = fk::human_motion(&bvh, &options)
         .with_context(|| format!("{}: forward kinematics", path.display()))?;
-    Ok(Human { bvh, motion, report })
+    Ok(Human { bvh, motion, report, take })
 }
 
 /// The BVH joints (End Sites included) as a skeleton figure; derived bodies are left out.
@@ -97,12 +108,16 @@ fn human_info(human: &Human) -> Vec<(String, String)> {
     let joints = &human.bvh.skeleton.joints;
     let ends = joints.iter().filter(|j| j.kind == bvh::JointKind::End).count();
     let r = &human.report;
-    vec![
+    let mut info = vec![
         ("joints".into(), format!("{} (+{ends} end sites)", joints.len() - ends)),
         ("channels".into(), human.bvh.skeleton.num_channels().to_string()),
         ("height".into(), format!("{:.2} m", r.height)),
         ("units".into(), format!("{} m per file unit", r.metres_per_unit)),
-    ]
+    ];
+    if let Some(take) = &human.take {
+        info.push(("take".into(), take.clone()));
+    }
+    info
 }
 
 fn bvh_scene(path: &Path) -> anyhow::Result<Scene> {

@@ -9,6 +9,7 @@ mod cmd_bvh;
 mod cmd_bvh_fk;
 mod cmd_bvh_map;
 mod cmd_c3d;
+mod cmd_fbx;
 mod cmd_report;
 mod cmd_retarget;
 mod cmd_robot;
@@ -20,7 +21,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// Retarget human motion capture (BVH, C3D) onto humanoid robots described in MJCF.
+/// Retarget human motion capture (BVH, FBX, C3D) onto humanoid robots described in MJCF.
 #[derive(Parser, Debug)]
 #[command(
     name = "retarget",
@@ -28,6 +29,7 @@ use clap::{Parser, Subcommand};
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true,
     override_usage = "retarget --bvh <FILE> --robot <ROBOT> [OPTIONS]\n       \
+                      retarget --fbx <FILE> [--take <NAME|N>] --robot <ROBOT> [OPTIONS]\n       \
                       retarget --c3d <FILE> --config <FILE> --robot <ROBOT> [OPTIONS]\n       \
                       retarget <COMMAND>"
 )]
@@ -47,6 +49,9 @@ enum Command {
     /// Inspect, dump and convert C3D files.
     #[command(subcommand)]
     C3d(cmd_c3d::C3dCommand),
+    /// Inspect FBX files, convert a take to BVH, show the skeleton's roles.
+    #[command(subcommand)]
+    Fbx(cmd_fbx::FbxCommand),
     /// List the robots and configs shipped with the tool.
     Robots,
     /// Inspect one robot model (shipped name, MJCF or URDF path).
@@ -66,6 +71,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Bvh(cmd)) => cmd_bvh::run(cmd),
         Some(Command::C3d(cmd)) => cmd_c3d::run(cmd),
+        Some(Command::Fbx(cmd)) => cmd_fbx::run(cmd),
         Some(Command::Robots) => cmd_robot::list(),
         Some(Command::Robot(cmd)) => cmd_robot::run(cmd),
         Some(Command::View(args)) => cmd_view::run(args),

@@ -62,6 +62,8 @@ fn a_missing_file_is_named_once_with_its_cause_once() {
         vec!["report".into(), missing("m.npz")],
         vec!["c3d".into(), "info".into(), missing("t.c3d")],
         vec!["bvh".into(), "info".into(), missing("a.bvh")],
+        vec!["fbx".into(), "info".into(), missing("a.fbx")],
+        vec!["--fbx".into(), missing("a.fbx"), "--robot".into(), "unitree_g1".into()],
         vec!["view".into(), missing("a.bvh")],
     ];
     for args in cases {
@@ -110,7 +112,9 @@ fn help_names_required_arguments_and_describes_every_argument() {
     assert!(main.contains("retarget --c3d <FILE> --config <FILE> --robot <ROBOT>"), "{main}");
     let entries = help_entries(&main);
     assert!(entries["--robot <ROBOT>"].starts_with("Robot (required)"), "{entries:?}");
-    assert!(entries["--bvh <FILE>"].contains("this or --c3d is required"), "{entries:?}");
+    assert!(entries["--bvh <FILE>"].contains("this, --fbx or --c3d is required"), "{entries:?}");
+    assert!(main.contains("retarget --fbx <FILE> [--take <NAME|N>] --robot <ROBOT>"), "{main}");
+    assert!(entries["--take <NAME|N>"].contains("the take with the most motion"), "{entries:?}");
     let commands = [
         "bvh info",
         "bvh json",
@@ -120,6 +124,9 @@ fn help_names_required_arguments_and_describes_every_argument() {
         "c3d info",
         "c3d dump",
         "c3d convert",
+        "fbx info",
+        "fbx bvh",
+        "fbx map",
         "robot info",
         "robot check",
         "robots",
@@ -211,7 +218,12 @@ fn main_command_and_batch_take_the_same_options() {
     for entries in [&main, &batch] {
         assert!(format(entries).contains("[possible values: npz, csv, pkl, json]"), "{entries:?}");
     }
-    assert!(batch["[IN_DIR]"].starts_with("Directory tree of BVH (and C3D) files"), "{batch:?}");
+    assert!(
+        batch["[IN_DIR]"].starts_with(
+            "Directory tree of BVH, FBX (each file's take with the most motion) and C3D"
+        ),
+        "{batch:?}"
+    );
 }
 
 #[test]
