@@ -122,6 +122,8 @@ class Retargeter:
     def config_json(self) -> str:
         """The config frames use (``step``, ``retarget_frames``), as JSON text."""
     def retarget_bvh(self, path: PathLike) -> Motion: ...
+    def retarget_fbx(self, path: PathLike, take: Optional[Union[str, int]] = None) -> Motion:
+        """One take (name or index; default: the one with the most motion)."""
     def retarget_c3d(self, path: PathLike, config: PathLike) -> Motion:
         """With a marker-driven IK config (``marker_bodies`` + IK tables)."""
     def retarget_frames(self, frames: Sequence[HumanData], fps: float = 30.0) -> Motion:
@@ -134,6 +136,7 @@ class Retargeter:
         """The last streamed frame's targets (GMR's ``scaled_human_data``)."""
 
 def load_bvh_gmr(path: PathLike, format: str = "lafan1") -> Tuple[List[Dict[str, List[npt.NDArray[np.float64]]]], float]: ...
+def load_fbx_frames(path: PathLike, take: Optional[Union[str, int]] = None) -> Tuple[List[Dict[str, List[npt.NDArray[np.float64]]]], float, str]: ...
 def batch(
     paths: Sequence[PathLike],
     robot: str,

@@ -7,7 +7,8 @@
 
 ``GeneralMotionRetargeting.retarget`` is GMR's per-frame solve reproduced exactly (the same
 targets, weights, damping, stopping rule and exact QP; our parity test holds it to 1e-6 rad of
-GMR's own output on the LAFAN1 walk). ``load_bvh_file`` returns what GMR's loader returns.
+GMR's own output on the LAFAN1 walk). ``load_bvh_file`` returns what GMR's loader returns; ``load_optitrack_fbx_motion_file`` reads
+an ``.fbx`` file itself into the frames GMR's FBX path (FBX SDK + poselib pickle) hands over.
 
 Differences: only GMR's ``bvh_lafan1`` configs ship (``src_human="bvh_lafan1"``); the solver is
 exact whatever ``solver`` names (GMR: daqp); ``use_velocity_limit`` changes nothing (GMR passes
@@ -25,7 +26,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["GeneralMotionRetargeting", "load_bvh_file"]
+__all__ = ["GeneralMotionRetargeting", "load_bvh_file", "load_fbx_file", "load_optitrack_fbx_motion_file"]
 
 #: GMR's ``src_human`` names we have configs for, by robot: GMR's ``IK_CONFIG_DICT``.
 IK_CONFIG_DICT: Dict[str, Dict[str, str]] = {
@@ -46,6 +47,26 @@ def load_bvh_file(bvh_file: "os.PathLike[str] | str", format: str = "lafan1") ->
     ``human_height`` is GMR's constant 1.75.
     """
     return _native.load_bvh_gmr(os.fspath(bvh_file), format)
+
+
+def load_optitrack_fbx_motion_file(motion_file: "os.PathLike[str] | str", take: "str | int | None" = None) -> List[Dict[str, List[np.ndarray]]]:
+    """GMR's ``scripts/fbx_offline_to_robot.py`` loader, for an ``.fbx`` file itself.
+
+    GMR reads FBX only through Autodesk's FBX SDK and poselib (``fbx_importer.py`` writes a
+    pickle of frames, which this function loads in GMR). Here the FBX file is read directly
+    and the frames are the same shape: per frame a dict ``{joint: [position, orientation]}``
+    of every skeleton joint (named as in the file), positions in metres with Z up,
+    orientations w x y z. ``take``: a take name or index (default: the take with the most
+    motion). The file's axes and unit are applied; a figure that is not human-sized is
+    scaled by its proportions, as ``Retargeter.retarget_fbx`` reads it.
+    """
+    return load_fbx_file(motion_file, take)[0]
+
+
+def load_fbx_file(fbx_file: "os.PathLike[str] | str", take: "str | int | None" = None) -> Tuple[List[Dict[str, List[np.ndarray]]], float]:
+    """``(frames, fps)`` of one take of an FBX file (see ``load_optitrack_fbx_motion_file``)."""
+    frames, fps, _name = _native.load_fbx_frames(os.fspath(fbx_file), take)
+    return frames, fps
 
 
 class GeneralMotionRetargeting:

@@ -11,7 +11,7 @@ use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping};
 
@@ -161,6 +161,22 @@ impl Retargeter {
     fn retarget_bvh(&self, py: Python<'_>, path: PathBuf) -> PyResult<Motion> {
         let inner = &self.inner;
         let (motion, diag) = py.detach(|| inner.retarget_bvh_file(&path)).map_err(to_py)?;
+        Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Retargets one take of an FBX file: ``take`` is its name or index (``None``: the take
+    /// with the most motion; ``Motion.inferred`` says which).
+    #[pyo3(signature = (path, take=None))]
+    fn retarget_fbx(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        take: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Motion> {
+        let take = take_selector(take)?;
+        let inner = &self.inner;
+        let (motion, diag) =
+            py.detach(|| inner.retarget_fbx_file(&path, take.as_deref())).map_err(to_py)?;
         Ok(Motion::new(motion, diag, inner.shared_model()))
     }
 
@@ -587,8 +603,54 @@ fn load_bvh_gmr<'py>(
     Ok((frames, retarget::gmr::HUMAN_HEIGHT))
 }
 
-/// Retargets BVH files into ``out_dir`` (``<stem>.<format>``) on ``jobs`` threads (0: one per
-/// core); returns one dict per file: ``input``, ``output``, and ``frames``, ``seconds``,
+/// A take given as a name (``str``) or an index (``int``).
+fn take_selector(take: Option<&Bound<'_, PyAny>>) -> PyResult<Option<String>> {
+    let Some(take) = take else { return Ok(None) };
+    if let Ok(index) = take.extract::<usize>() {
+        return Ok(Some(index.to_string()));
+    }
+    take.extract::<String>()
+        .map(Some)
+        .map_err(|_| PyTypeError::new_err("take: expected a take name (str) or index (int)"))
+}
+
+/// One take of an FBX file as frames of ``{body: [position, wxyz quaternion]}`` (every
+/// skeleton joint; metres, Z up, the file's axes and unit as ``retarget_fbx`` reads them),
+/// with the frame rate and the take's name.
+#[pyfunction]
+#[pyo3(signature = (path, take=None))]
+fn load_fbx_frames<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    take: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyList>, f64, String)> {
+    let take = take_selector(take)?;
+    let (human, name) = py
+        .detach(|| {
+            let clip = retarget::FbxClip::read(&path, take.as_deref())?;
+            let options =
+                clip.fk_options(&fk::FkOptions { derived: Vec::new(), ..Default::default() });
+            let (human, _) = fk::human_motion(&clip.bvh, &options)?;
+            Ok((human, clip.take.name))
+        })
+        .map_err(|e: retarget::Error| to_py(e))?;
+    let frames = PyList::empty(py);
+    let nb = human.num_bodies().max(1);
+    let rows = human.positions.chunks_exact(nb).zip(human.orientations.chunks_exact(nb));
+    for (positions, orientations) in rows {
+        let frame = PyDict::new(py);
+        for ((body, p), q) in human.body_names.iter().zip(positions).zip(orientations) {
+            let pos = PyArray1::from_slice(py, &[p.x, p.y, p.z]);
+            let quat = PyArray1::from_slice(py, &[q.w, q.i, q.j, q.k]);
+            frame.set_item(body, PyList::new(py, [pos.into_any(), quat.into_any()])?)?;
+        }
+        frames.append(frame)?;
+    }
+    Ok((frames, human.fps, name))
+}
+
+/// Retargets BVH and FBX files (the take with the most motion) into ``out_dir``
+/// (``<stem>.<format>``) on ``jobs`` threads (0: one per core); returns one dict per file: ``input``, ``output``, and ``frames``, ``seconds``,
 /// ``inferred`` or ``error``.
 #[pyfunction]
 #[pyo3(signature = (paths, robot, out_dir, jobs=0, *, config=None, mode="default", format="npz", human_height=None))]
@@ -645,6 +707,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Motion>()?;
     m.add("RetargetError", m.py().get_type::<RetargetError>())?;
     m.add_function(wrap_pyfunction!(load_bvh_gmr, m)?)?;
+    m.add_function(wrap_pyfunction!(load_fbx_frames, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(shipped_robots, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
