@@ -28,6 +28,17 @@ pub enum FbxCommand {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// The take's FK (m, Z up) and roles as an `.npz`, as `retarget bvh fk --npz` writes it.
+    Fk {
+        /// The FBX file.
+        file: PathBuf,
+        /// The take (default: the take with the most motion).
+        #[arg(long, value_name = "NAME|N")]
+        take: Option<String>,
+        /// The `.npz` to write (`body_pos_w`, `body_quat_w`, roles; see `retarget bvh fk`).
+        #[arg(long, value_name = "OUT.npz", required = true)]
+        npz: PathBuf,
+    },
     /// Which joint plays each role (pelvis, left_thigh, …) and why; up axis, unit, rest pose.
     Map {
         /// The FBX file.
@@ -70,6 +81,13 @@ pub fn run(cmd: FbxCommand) -> anyhow::Result<ExitCode> {
                 info.metres_per_unit,
                 output.map(|p| format!(": wrote {}", p.display())).unwrap_or_default()
             );
+        }
+        FbxCommand::Fk { file, take, npz } => {
+            let clip = FbxClip::read(&file, take.as_deref())?;
+            let options = clip.fk_options(&fk::FkOptions::default());
+            crate::cmd_bvh_fk::write_npz(&clip.bvh, &options, &npz)
+                .with_context(|| file.display().to_string())?;
+            println!("{}: {}; wrote {}", file.display(), clip.summary(), npz.display());
         }
         FbxCommand::Map { file, take, map } => {
             let clip = FbxClip::read(&file, take.as_deref())?;

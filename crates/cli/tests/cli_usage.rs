@@ -126,6 +126,7 @@ fn help_names_required_arguments_and_describes_every_argument() {
         "c3d convert",
         "fbx info",
         "fbx bvh",
+        "fbx fk",
         "fbx map",
         "robot info",
         "robot check",
