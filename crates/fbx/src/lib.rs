@@ -46,6 +46,11 @@ pub struct Fbx {
     info: Info,
     node_ids: Vec<usize>,
     rest: Vec<UnitQuaternion<f64>>,
+    /// ufbx's memory limit for evaluating the scene (as for loading it).
+    memory_limit: usize,
+    /// Every skeleton node inherits its parent's transform normally (`InheritType` RSrs):
+    /// world matrices are chained from local ones ([`Fbx::poses_at`]).
+    normal_inheritance: bool,
 }
 
 impl std::fmt::Debug for Fbx {
@@ -81,12 +86,15 @@ impl Fbx {
             return Err(Error::Axes { file: file.to_owned(), axes: loaded.info.axes.to_string() });
         }
         let (rest, _from_bind) = scene::rest_rotations(&loaded.scene, &loaded.node_ids);
+        let normal_inheritance = scene::normal_inheritance(&loaded.scene, &loaded.node_ids);
         Ok(Fbx {
             scene: loaded.scene,
             file: file.to_owned(),
             info: loaded.info,
             node_ids: loaded.node_ids,
             rest,
+            memory_limit: scene::memory_limit(bytes.len()),
+            normal_inheritance,
         })
     }
 

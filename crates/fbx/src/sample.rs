@@ -56,39 +56,117 @@ impl Fbx {
         Ok(poses)
     }
 
+    fn evaluate_opts(&self) -> ufbx::EvaluateOpts<'static> {
+        let limits = || ufbx::AllocatorOpts {
+            memory_limit: self.memory_limit,
+            ..ufbx::AllocatorOpts::default()
+        };
+        ufbx::EvaluateOpts {
+            temp_allocator: limits(),
+            result_allocator: limits(),
+            ..ufbx::EvaluateOpts::default()
+        }
+    }
+
     /// The skeleton's world matrices in take `take` at time `t`.
     fn world_at(&self, take: usize, t: f64, out: &mut Vec<Matrix4<f64>>) -> Result<(), Error> {
-        let name = self.take_name(take);
         let stack = self.scene.anim_stacks.get(take).ok_or_else(|| Error::UnknownTake {
             file: self.file.clone(),
             take: take.to_string(),
             available: self.takes_list(),
         })?;
-        let evaluated =
-            ufbx::evaluate_scene(&self.scene, &stack.anim, t, ufbx::EvaluateOpts::default())
-                .map_err(|e| Error::Evaluate {
-                    file: self.file.clone(),
-                    take: name.clone(),
-                    time: t,
-                    message: scene::ufbx_message(&e),
-                })?;
         out.clear();
-        for (i, &id) in self.node_ids.iter().enumerate() {
-            let m = evaluated.nodes.get(id).map(|node| scene::matrix(&node.node_to_world));
-            match m {
-                Some(m) if m.iter().all(|x| x.is_finite()) => out.push(m),
-                _ => {
-                    let node = self.info.skeleton.get(i).map_or("?", |n| n.name.as_str());
-                    return Err(Error::NonFinite {
-                        file: self.file.clone(),
-                        take: name,
-                        time: t,
-                        node: node.to_owned(),
-                    });
-                }
+        if self.normal_inheritance {
+            self.compose(&stack.anim, t, out);
+        } else {
+            self.evaluate(take, &stack.anim, t, out)?;
+        }
+        match out.iter().position(|m| !m.iter().all(|x| x.is_finite())) {
+            None => Ok(()),
+            Some(i) => {
+                let node = self.info.skeleton.get(i).map_or("?", |n| n.name.as_str());
+                Err(Error::NonFinite {
+                    file: self.file.clone(),
+                    take: self.take_name(take),
+                    time: t,
+                    node: node.to_owned(),
+                })
             }
         }
+    }
+
+    /// World matrices chained from each node's evaluated local transform
+    /// (`ufbx_evaluate_transform`: the curves, pre-/post-rotation, pivots and offsets), as
+    /// ufbx's own scene evaluation composes them when every node inherits normally
+    /// (`node_to_world = parent.node_to_world · node_to_parent`), without copying the scene
+    /// for every frame: 5–10 times faster on the shared files.
+    fn compose(&self, anim: &ufbx::Anim, t: f64, out: &mut Vec<Matrix4<f64>>) {
+        for (i, &id) in self.node_ids.iter().enumerate() {
+            let Some(node) = self.scene.nodes.get(id) else {
+                out.push(Matrix4::from_element(f64::NAN));
+                continue;
+            };
+            let local = ufbx::evaluate_transform(anim, node, t);
+            let local = scene::matrix(&ufbx::transform_to_matrix(&local));
+            let parent = self.info.skeleton.get(i).and_then(|n| n.parent).and_then(|p| out.get(p));
+            let world = match parent {
+                Some(p) => p * local,
+                None => {
+                    node.parent.as_ref().map_or(local, |p| scene::matrix(&p.node_to_world) * local)
+                }
+            };
+            out.push(world);
+        }
+    }
+
+    /// World matrices from ufbx's evaluation of the whole scene (any inherit type).
+    fn evaluate(
+        &self,
+        take: usize,
+        anim: &ufbx::Anim,
+        t: f64,
+        out: &mut Vec<Matrix4<f64>>,
+    ) -> Result<(), Error> {
+        let evaluated =
+            ufbx::evaluate_scene(&self.scene, anim, t, self.evaluate_opts()).map_err(|e| {
+                Error::Evaluate {
+                    file: self.file.clone(),
+                    take: self.take_name(take),
+                    time: t,
+                    message: scene::ufbx_message(&e),
+                }
+            })?;
+        for &id in &self.node_ids {
+            let m = evaluated.nodes.get(id).map(|node| scene::matrix(&node.node_to_world));
+            out.push(m.unwrap_or_else(|| Matrix4::from_element(f64::NAN)));
+        }
         Ok(())
+    }
+
+    /// [`Fbx::poses_at`] through ufbx's evaluation of the whole scene at each time, whatever
+    /// the inherit types: what [`Fbx::poses_at`] does for files with other inherit types, and
+    /// the reference its faster chaining is tested against.
+    pub fn poses_by_scene_evaluation(&self, take: usize, times: &[f64]) -> Result<Poses, Error> {
+        let stack = self.scene.anim_stacks.get(take).ok_or_else(|| Error::UnknownTake {
+            file: self.file.clone(),
+            take: take.to_string(),
+            available: self.takes_list(),
+        })?;
+        let n = self.node_ids.len();
+        let mut poses = Poses {
+            times: times.to_vec(),
+            num_nodes: n,
+            positions: Vec::with_capacity(times.len() * n),
+            rotations: Vec::with_capacity(times.len() * n),
+        };
+        let mut world = Vec::with_capacity(n);
+        for &t in times {
+            world.clear();
+            self.evaluate(take, &stack.anim, t, &mut world)?;
+            poses.positions.extend(world.iter().map(math::translation));
+            poses.rotations.extend(world.iter().map(math::rotation));
+        }
+        Ok(poses)
     }
 
     /// Take `take` sampled at its frames ([`crate::TakeInfo::frames`]) as a BVH in the file's

@@ -152,6 +152,24 @@ fn an_ascii_6100_file_reads_as_the_same_walk() {
 }
 
 #[test]
+fn chained_local_transforms_equal_ufbxs_scene_evaluation() {
+    for (name, take) in [("mixamo_zup_7400_ascii.fbx", 1), ("biped_6100_ascii.fbx", 0)] {
+        let fbx = open(name);
+        let times = [-0.5, 0.0, 0.33, 1.0, 1.7, 3.0];
+        let (a, b) = (
+            fbx.poses_at(take, &times).unwrap(),
+            fbx.poses_by_scene_evaluation(take, &times).unwrap(),
+        );
+        for (p, q) in a.positions.iter().zip(&b.positions) {
+            assert!((p - q).norm() < 1e-9, "{name}: {p} vs {q}");
+        }
+        for (p, q) in a.rotations.iter().zip(&b.rotations) {
+            assert!(p.angle_to(q) < 1e-9, "{name}");
+        }
+    }
+}
+
+#[test]
 fn a_file_without_a_rate_says_which_it_assumed() {
     let fbx = open("default_rate_7400_ascii.fbx");
     let info = fbx.info();

@@ -8,6 +8,7 @@
 //! evaluation. `cargo test -p fbx --release --test oracle -- --nocapture` prints the
 //! measured numbers.
 
+#[path = "support/npz.rs"]
 mod npz;
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
@@ -203,5 +204,23 @@ fn the_bvh_path_gives_the_same_positions_through_fk_and_a_written_file() {
             eprintln!("{stem}: written BVH re-read: {roundtrip:.1e} m");
             assert!(roundtrip < 1e-6, "{stem}: the re-read BVH is off by {roundtrip} m");
         }
+    }
+}
+
+/// Chaining local transforms (the fast path, every file here inherits normally) gives what
+/// ufbx's whole-scene evaluation gives.
+#[test]
+fn chained_local_transforms_equal_ufbxs_scene_evaluation() {
+    let Some(shared) = shared::shared_dir() else { return };
+    for (stem, _) in FILES {
+        let fbx = open(&shared, stem);
+        let times: Vec<f64> = (0..25).map(|k| -0.1 + f64::from(k) * 0.09).collect();
+        let (a, b) =
+            (fbx.poses_at(0, &times).unwrap(), fbx.poses_by_scene_evaluation(0, &times).unwrap());
+        let worst =
+            a.positions.iter().zip(&b.positions).map(|(p, q)| (p - q).norm()).fold(0.0, f64::max);
+        let angle =
+            a.rotations.iter().zip(&b.rotations).map(|(p, q)| p.angle_to(q)).fold(0.0, f64::max);
+        assert!(worst < 1e-9 && angle < 1e-9, "{stem}: {worst} file units, {angle} rad");
     }
 }

@@ -1,6 +1,7 @@
 //! The fuzz targets: one per parser, each running the stages that follow a successful parse
 //! (BVH → FK and role recognition; C3D → markers; MJCF/URDF → kinematics; IK config →
-//! validation and targets against the G1; npz → the quality report on the G1).
+//! validation and targets against the G1; npz → the quality report on the G1; FBX → takes,
+//! BVH and FK, in `fbx_target`).
 
 use std::fmt::Write as _;
 use std::io::Cursor;
@@ -21,6 +22,7 @@ pub fn all() -> Vec<Box<dyn Target>> {
         Box::new(UrdfTarget),
         Box::new(ConfigTarget),
         Box::new(NpzTarget),
+        Box::new(crate::fbx_target::FbxTarget),
     ]
 }
 
@@ -35,7 +37,7 @@ fn workspace() -> PathBuf {
 }
 
 /// Files under `dir` (relative to the workspace) whose name ends with `suffix`.
-fn files(dir: &str, suffix: &str) -> Vec<Vec<u8>> {
+pub(crate) fn files(dir: &str, suffix: &str) -> Vec<Vec<u8>> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(workspace().join(dir))
         .map(|entries| entries.flatten().map(|e| e.path()).collect())
         .unwrap_or_default();
