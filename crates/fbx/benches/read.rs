@@ -1,5 +1,6 @@
 //! FBX reading throughput, MB/s of file: ufbx's load with our skeleton and take info
-//! (`load`), the default take sampled into a BVH (`take`), and for comparison `fbxcel`'s
+//! (`load`), the default take sampled into a BVH (`take`, load included; `sample_frames`:
+//! frames/s of the sampling alone), and for comparison `fbxcel`'s
 //! token tree of the same bytes (`fbxcel_tree`: binary 7.4/7.5 only, no semantics; the
 //! library we did not choose, see docs/fbx.md).
 //!
@@ -56,6 +57,12 @@ fn benches(c: &mut Criterion) {
                 file.bvh(take.index).unwrap()
             })
         });
+        let file = fbx::Fbx::from_bytes(bytes, name).unwrap();
+        let take = file.select_take(None).unwrap().index;
+        let frames = file.info().takes[take].frames as u64;
+        group.throughput(Throughput::Elements(frames));
+        group.bench_function("sample_frames", |b| b.iter(|| file.bvh(take).unwrap()));
+        group.throughput(Throughput::Bytes(bytes.len() as u64));
         let binary = bytes.starts_with(b"Kaydara FBX Binary");
         if binary {
             group.bench_function("fbxcel_tree", |b| {

@@ -111,7 +111,7 @@ impl Fbx {
 
     /// The take `selector` names (its name, else its index in [`Info::takes`]), or with
     /// `None` the take with the most motion (the sum of the skeleton's joint paths over up to
-    /// [`MOTION_SAMPLES`] frames; the first of equals). Errors: no take at all, an unknown
+    /// 32 frames; the first of equals). Errors: no take at all, an unknown
     /// take, or (default) no take with keys.
     pub fn select_take(&self, selector: Option<&str>) -> Result<Selected, Error> {
         let takes = &self.info.takes;
@@ -151,7 +151,7 @@ impl Fbx {
     }
 
     /// How much take `take` moves: the summed path of every node over up to
-    /// [`MOTION_SAMPLES`] of its frames, in file units.
+    /// 32 of its frames, in file units.
     pub fn motion(&self, take: usize) -> Result<f64, Error> {
         let times = self.frame_times(take)?;
         let count = times.len().min(MOTION_SAMPLES);

@@ -27,8 +27,8 @@ pub struct Poses {
     pub num_nodes: usize,
     /// Frame-major: node `i` at time `k` is `[k * num_nodes + i]`.
     pub positions: Vec<Vector3<f64>>,
-    /// The rotation of each node's world matrix (scale removed; mirrored nodes: see
-    /// [`math::rotation`]).
+    /// The rotation of each node's world matrix `M` (scale removed; a mirrored node, whose
+    /// `det M < 0`, gets the rotation of `−M`).
     pub rotations: Vec<UnitQuaternion<f64>>,
 }
 

@@ -337,7 +337,7 @@ const PREFIXES: &[&str] = &[
 
 /// A joint name reduced for comparison: the part after the last `:` (namespaces), without
 /// an exporter prefix (`mixamorig_`, `DEF-`, `Bip01 `, `CC_Base_`, Xsens' `j` before a
-/// capital), lowercase, accents removed ([`fold`]), letters and digits only.
+/// capital), lowercase, Latin accents removed (`ê` → `e`), letters and digits only.
 #[must_use]
 pub fn normalise(name: &str) -> String {
     let name = name.rsplit(':').next().unwrap_or(name);
