@@ -291,3 +291,33 @@ impl Model {
         self.dof_joint[dof]
     }
 }
+
+impl Model {
+    /// `alignfree`: a free body without children gets its inertial frame as its body frame
+    /// (geoms and sites re-expressed in it, `qpos0` the new pose). A body whose inertia MuJoCo
+    /// takes from its geoms is left as it is (its inertial frame is not computed here).
+    pub(crate) fn align_to_inertia(&mut self, id: usize) {
+        let Some(body) = self.bodies.get_mut(id) else { return };
+        let Some(i) = body.inertial else { return };
+        let (pos, quat) = (body.pos + body.quat * i.pos, body.quat * i.quat);
+        let inverse = i.quat.inverse();
+        body.pos = pos;
+        body.quat = quat;
+        body.inertial =
+            Some(Inertial { pos: Vector3::zeros(), quat: UnitQuaternion::identity(), ..i });
+        for g in self.geoms.iter_mut().filter(|g| g.body == id) {
+            g.pos = inverse * (g.pos - i.pos);
+            g.quat = inverse * g.quat;
+        }
+        for s in self.sites.iter_mut().filter(|s| s.body == id) {
+            s.pos = inverse * (s.pos - i.pos);
+            s.quat = inverse * s.quat;
+        }
+        for j in self.joints.iter().filter(|j| j.body == id && j.kind == JointType::Free) {
+            let a = j.qpos_adr;
+            if let Some(q) = self.qpos0.get_mut(a..a + 7) {
+                q.copy_from_slice(&[pos.x, pos.y, pos.z, quat.w, quat.i, quat.j, quat.k]);
+            }
+        }
+    }
+}

@@ -321,8 +321,10 @@ fn errors_name_file_line_and_column() {
         ("<robot name=\"r\">\n<link name=\"a\"></robot>".to_owned(), "<string>:2:16: invalid xml: expected 'link' tag, not 'robot'"),
         ("<mujoco/>".to_owned(), "<string>:1:1: root element is <mujoco>, expected <robot>"),
         ("<robot name=\"r\"/>".to_owned(), "<string>:1:1: <robot> has no <link>"),
-        (robot("<mujoco><compiler discardvisual=\"false\"/></mujoco>"),
-         "<string>:2:19: unsupported: discardvisual=\"false\" (visual geoms are not read)"),
+        (robot("<mujoco><compiler coordinate=\"global\"/></mujoco>"),
+         "<string>:2:19: global coordinates no longer supported. To convert existing models, load and save them in MuJoCo 2.3.3 or older"),
+        (robot("<mujoco><compiler discardvisual=\"no\"/></mujoco>"),
+         "<string>:2:19: attribute discardvisual: \"no\" is not true or false"),
         (robot(&format!("{}{}", link("world"), joint("j", "fixed", "a", "world"))),
          "<string>:2:1: a link called \"world\" must be the root link"),
         // <inertial>: MuJoCo's required elements and attributes, and its checks.
