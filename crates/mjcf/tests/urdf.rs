@@ -374,3 +374,20 @@ fn errors_name_file_line_and_column() {
         .to_string()
         .starts_with("/nonexistent/robot.urdf: cannot read file"));
 }
+
+/// A floating base added to the fixed robot is the free root the URDF reader adds itself.
+#[test]
+fn floating_base_added_later_is_the_urdf_free_root() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/urdf/features.urdf");
+    // Unfused: fixed to the world, the root link would be fused into it.
+    let fixed = UrdfOptions { base: UrdfBase::Fixed, fuse_static: Some(false) };
+    let mut m = Model::from_urdf_file(&path, fixed).unwrap();
+    let floating =
+        Model::from_urdf_file(&path, UrdfOptions { base: UrdfBase::Floating, ..fixed }).unwrap();
+    let root = m.root_body().unwrap();
+    let (pos, quat) = (m.bodies[root].pos, m.bodies[root].quat);
+    let base = m.add_floating_base(pos, quat).unwrap();
+    assert_eq!(base.joint, floating.joints[0].name);
+    assert_eq!(m, floating);
+    assert_eq!(m.clone().add_floating_base(pos, quat), None, "a second one is not added");
+}
