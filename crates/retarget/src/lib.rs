@@ -75,6 +75,7 @@ pub mod contact;
 pub mod derive;
 mod error;
 pub mod feet;
+pub mod follow;
 pub mod gmr;
 pub mod joint_speed;
 pub mod lie;
