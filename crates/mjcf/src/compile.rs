@@ -89,7 +89,15 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
         },
     };
     let main_class = mjcf.default.class.clone();
-    compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
+    let mut budget = MAX_EXPANDED;
+    let world = expand_replicates(
+        &mjcf.worldbody,
+        compiler.angle_scale,
+        compiler.eulerseq,
+        src,
+        &mut budget,
+    )?;
+    compiler.body(&world, 0, Frame::IDENTITY, &main_class)?;
     let total_mass = compiler.inertia.total_mass;
     let mut model = compiler.model;
     if let Some(total) = total_mass {
@@ -103,6 +111,107 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
     model.geom_mat = model.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
     model.site_mat = model.sites.iter().map(|s| *s.quat.to_rotation_matrix().matrix()).collect();
     Ok(model)
+}
+
+/// The body tree with every `<replicate>` turned into its copies, each a `<frame>` placing it
+/// (MuJoCo 3.17 expands them the same way before compiling: copy `i` at the `i`-th power of
+/// the replicate's frame, names suffixed).
+fn expand_replicates(
+    body: &BodySpec,
+    angle_scale: f64,
+    eulerseq: [u8; 3],
+    src: &Sources,
+    budget: &mut usize,
+) -> Result<BodySpec, Error> {
+    let mut out = body.clone();
+    out.items = expand_items(&body.items, angle_scale, eulerseq, src, budget)?;
+    Ok(out)
+}
+
+/// Items nested replicates may make in all (their product grows fast).
+const MAX_EXPANDED: usize = 1_000_000;
+
+fn expand_items(
+    items: &[Item],
+    angle_scale: f64,
+    eulerseq: [u8; 3],
+    src: &Sources,
+    budget: &mut usize,
+) -> Result<Vec<Item>, Error> {
+    let mut out = Vec::with_capacity(items.len());
+    for item in items {
+        match item {
+            Item::Body(b) => {
+                out.push(Item::Body(expand_replicates(b, angle_scale, eulerseq, src, budget)?))
+            }
+            Item::Frame(f) => {
+                out.push(Item::Frame(expand_replicates(f, angle_scale, eulerseq, src, budget)?))
+            }
+            Item::Replicate(r) => {
+                let inner = expand_items(&r.items, angle_scale, eulerseq, src, budget)?;
+                let size = inner.iter().map(item_count).sum::<usize>().max(1);
+                *budget = budget.checked_sub(size.saturating_mul(r.count)).ok_or_else(|| {
+                    src.invalid(
+                        r.pos,
+                        format!("replicates expand to more than {MAX_EXPANDED} elements"),
+                    )
+                })?;
+                let step = Frame {
+                    pos: Vector3::from(r.offset),
+                    quat: orientation_to_quat(&Orientation::Euler(r.euler), angle_scale, eulerseq)
+                        .ok_or_else(|| src.invalid(r.pos, "degenerate replicate euler"))?,
+                };
+                let digits = r.count.to_string().len();
+                let mut frame = Frame::IDENTITY;
+                for i in 0..r.count {
+                    let suffix = format!("{}{i:0digits$}", r.sep);
+                    let mut copy = inner.clone();
+                    copy.iter_mut().for_each(|item| suffix_names(item, &suffix));
+                    let q = frame.quat;
+                    out.push(Item::Frame(BodySpec {
+                        name: None,
+                        childclass: None,
+                        translation: Some(frame.pos.into()),
+                        orientation: Some((Orientation::Quat([q.w, q.i, q.j, q.k]), r.pos)),
+                        items: copy,
+                        mocap: false,
+                        pos: r.pos,
+                    }));
+                    frame = frame.compose(step.pos, step.quat);
+                }
+            }
+            other => out.push(other.clone()),
+        }
+    }
+    Ok(out)
+}
+
+/// Elements in `item`, itself included.
+fn item_count(item: &Item) -> usize {
+    1 + match item {
+        Item::Body(b) | Item::Frame(b) => b.items.iter().map(item_count).sum(),
+        Item::Replicate(r) => r.items.iter().map(item_count).sum(),
+        _ => 0,
+    }
+}
+
+/// Appends `suffix` to every name in `item` (bodies, joints, geoms, sites, and within).
+fn suffix_names(item: &mut Item, suffix: &str) {
+    let add = |name: &mut Option<String>| {
+        if let Some(n) = name.as_mut() {
+            n.push_str(suffix);
+        }
+    };
+    match item {
+        Item::Joint(j) => add(&mut j.name),
+        Item::Geom(g) | Item::Site(g) => add(&mut g.name),
+        Item::Inertial(_) => {}
+        Item::Body(b) | Item::Frame(b) => {
+            add(&mut b.name);
+            b.items.iter_mut().for_each(|i| suffix_names(i, suffix));
+        }
+        Item::Replicate(r) => r.items.iter_mut().for_each(|i| suffix_names(i, suffix)),
+    }
 }
 
 /// MuJoCo's defaults: `inertiafromgeom="auto"`, no bounds, no balancing, no total mass.
@@ -400,6 +509,8 @@ impl<'a> Compiler<'a> {
                     let inner = self.childclass(f, class)?;
                     self.collect(&f.items, frame.compose(pos, quat), inner, out)?;
                 }
+                // Expanded into frames before compiling (`expand_replicates`).
+                Item::Replicate(_) => {}
             }
         }
         Ok(())
@@ -939,5 +1050,26 @@ mod tests {
         let bad = r#"<mujoco><worldbody><body><body mocap="true"/></body></worldbody></mujoco>"#;
         let err = Model::from_xml_str(bad, None).unwrap_err().to_string();
         assert!(err.contains("mocap body must be a child of the world"), "{err}");
+    }
+
+    /// `<replicate>` as MuJoCo 3.17 expands it: copy `i` at the `i`-th power of its frame,
+    /// names suffixed by `sep` and `i` padded to the digits of `count`, inner suffixes first.
+    #[test]
+    fn replicate_copies_its_children() {
+        let xml = r#"<mujoco><worldbody><body name="base"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+              <replicate count="3" offset="0 0.2 0" euler="0 0 30" sep="-">
+                <body name="a" pos="1 0 0"><joint name="j"/><geom name="g" size="0.1"/>
+                  <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></replicate></body>
+              <replicate count="2" offset="1 0 0" sep="o"><replicate count="12" offset="0 0.2 0" sep="i">
+                <body name="c"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+              </replicate></replicate></worldbody></mujoco>"#;
+        let m = model(xml);
+        let names: Vec<_> = m.bodies.iter().map(|b| b.name.as_str()).take(6).collect();
+        assert_eq!(names, ["world", "base", "a-0", "a-1", "a-2", "ci00o0"]);
+        assert_eq!(m.bodies.len(), 2 + 3 + 24);
+        let a2 = &m.bodies[4];
+        assert!((a2.pos - Vector3::new(0.4, 1.2392304845413262, 0.0)).norm() < 1e-12, "{}", a2.pos);
+        assert_eq!(m.joints[2].name, "j-2");
+        matches_mujoco(&m, xml, 28);
     }
 }

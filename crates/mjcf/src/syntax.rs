@@ -140,6 +140,20 @@ pub(crate) enum Item {
     Inertial(InertialSpec),
     Body(BodySpec),
     Frame(BodySpec),
+    Replicate(ReplicateSpec),
+}
+
+/// `<replicate count offset euler sep>`: its children `count` times, copy `i` placed by the
+/// `i`-th power of the frame (`offset`, `euler`), every name in it suffixed by `sep` and `i`
+/// (zero-padded to the digits of `count`), as MuJoCo 3.17 expands it.
+#[derive(Debug, Clone)]
+pub(crate) struct ReplicateSpec {
+    pub count: usize,
+    pub offset: [f64; 3],
+    pub euler: [f64; 3],
+    pub sep: String,
+    pub items: Vec<Item>,
+    pub pos: Pos,
 }
 
 /// A `<body>`, a `<frame>` or the `<worldbody>` (name `world`).
@@ -376,6 +390,7 @@ fn parse_item(el: &Element, src: &Sources, in_world: bool) -> Result<Option<Item
     let item = match el.name.as_str() {
         "body" => Item::Body(parse_body(el, src)?),
         "frame" => Item::Frame(parse_body(el, src)?),
+        "replicate" => Item::Replicate(parse_replicate(el, src, in_world)?),
         "joint" | "freejoint" if in_world => {
             return Err(src.invalid(el.pos, format!("<{}> directly in <worldbody>", el.name)));
         }
@@ -411,6 +426,35 @@ fn parse_body(el: &Element, src: &Sources) -> Result<BodySpec, Error> {
     }
     Ok(body)
 }
+
+fn parse_replicate(el: &Element, src: &Sources, in_world: bool) -> Result<ReplicateSpec, Error> {
+    let count_attr = el
+        .attr("count")
+        .ok_or_else(|| src.invalid(el.pos, "<replicate> needs the attribute count"))?;
+    let count = usize::try_from(int(count_attr, src)?)
+        .ok()
+        .filter(|c| (1..=MAX_REPLICATE).contains(c))
+        .ok_or_else(|| {
+            src.invalid(count_attr.pos, format!("replicate count must be 1 to {MAX_REPLICATE}"))
+        })?;
+    let mut spec = ReplicateSpec {
+        count,
+        offset: el.attr("offset").map(|a| floats::<3>(a, src)).transpose()?.unwrap_or_default(),
+        euler: el.attr("euler").map(|a| floats::<3>(a, src)).transpose()?.unwrap_or_default(),
+        sep: el.attr("sep").map(|a| a.value.clone()).unwrap_or_default(),
+        items: Vec::new(),
+        pos: el.pos,
+    };
+    for child in &el.children {
+        if let Some(item) = parse_item(child, src, in_world)? {
+            spec.items.push(item);
+        }
+    }
+    Ok(spec)
+}
+
+/// Copies one `<replicate>` may make (each a copy of its subtree: the file's size bounds it).
+const MAX_REPLICATE: usize = 10_000;
 
 fn parse_joint(el: &Element, src: &Sources) -> Result<JointSpec, Error> {
     Ok(JointSpec {
