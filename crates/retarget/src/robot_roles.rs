@@ -5,6 +5,8 @@
 //!
 //! The rules, in the order they run (each role's [`RobotRole::rule`] says which decided it):
 //!
+//! 0. A model without a free joint gets one first ([`add_floating_base`], called by
+//!    [`crate::shipped::load_robot`]), stood up when it lies at `qpos0`.
 //! 1. **Floating base**: the body of the first free joint (a URDF gets one on loading).
 //! 2. **Legs**: the lowest body at `qpos0` (origin or primitive geom) is one foot; walking up
 //!    its ancestors, the first one with another branch that reaches as low (within 15 % of the
