@@ -107,7 +107,13 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         }
         crate::atomic_write(path, text.as_bytes())?;
     }
-    match std::io::stdout().lock().write_all(rep.to_string().as_bytes()) {
+    let mut text = rep.to_string();
+    if let Ok(roles) = retarget::RobotRoles::recognise(&model) {
+        for blocked in retarget::follow::blocked_limbs(&model, &roles, &motion) {
+            text.push_str(&format!("cannot follow: {blocked}\n"));
+        }
+    }
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(ExitCode::SUCCESS),
     }

@@ -112,6 +112,9 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         ..RetargetOptions::default()
     };
     let mut retargeter = Retargeter::new(&robot)?.with_options(options);
+    for note in retargeter.robot_notes() {
+        println!("robot: {note}");
+    }
     let (motion, diag) = if args.c3d.is_some() {
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
         let config = IkConfig::from_file(config_path)?;
@@ -156,7 +159,29 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     }
     let wall = started.elapsed().as_secs_f64();
     print_summary(&input, &output, &motion, &diag, wall, args.both_ways);
+    print_blocked(model, &motion);
     Ok(ExitCode::SUCCESS)
+}
+
+/// Stretches of `cannot follow` the main command prints.
+const SHOWN_BLOCKED: usize = 5;
+
+/// The stretches in which a limb cannot follow the human ([`retarget::follow`]), one line
+/// each, the longest first (nothing for a robot the recogniser does not read).
+pub fn print_blocked(model: &mjcf::Model, motion: &RobotMotion) {
+    let Ok(roles) = retarget::RobotRoles::recognise(model) else { return };
+    let mut blocked = retarget::follow::blocked_limbs(model, &roles, motion);
+    // The longest first, five at most (`retarget report` lists them all).
+    blocked.sort_by_key(|b| std::cmp::Reverse(b.last - b.first));
+    for b in blocked.iter().take(SHOWN_BLOCKED) {
+        println!("cannot follow: {b}");
+    }
+    if blocked.len() > SHOWN_BLOCKED {
+        println!(
+            "cannot follow: {} shorter stretches more (`retarget report` lists them)",
+            blocked.len() - SHOWN_BLOCKED
+        );
+    }
 }
 
 /// A robot argument as messages name it: the shipped key, or the model file's stem.

@@ -87,7 +87,7 @@ pub fn run(cmd: RobotCommand) -> anyhow::Result<ExitCode> {
 }
 
 fn info(robot: &str, json: Option<&std::path::Path>) -> anyhow::Result<ExitCode> {
-    let model = shipped::robot_model(robot)?;
+    let (model, notes) = retarget::shipped::load_robot_noted(robot)?;
     if let Some(path) = json {
         let roles = retarget::RobotRoles::recognise(&model)?;
         let text = serde_json::to_string_pretty(&roles_json(&model, &roles))?;
@@ -95,6 +95,9 @@ fn info(robot: &str, json: Option<&std::path::Path>) -> anyhow::Result<ExitCode>
     }
     let mut out = String::new();
     writeln!(out, "robot: {robot}")?;
+    for note in &notes {
+        writeln!(out, "note: {note}")?;
+    }
     writeln!(
         out,
         "nq {}  nv {}  joint dofs {}  bodies {}",
@@ -262,7 +265,11 @@ fn init(
 #[cfg(feature = "mujoco")]
 fn check(robot: &str, configs: usize, seed: u64, tolerance: f64) -> anyhow::Result<ExitCode> {
     use mjcf::mujoco_check::{check_file, check_xml_str, CheckOptions};
-    let model = shipped::robot_model(robot)?;
+    // The file as MuJoCo reads it: no floating base added to a model without one.
+    let model = match shipped::shipped_xml(robot) {
+        Some(_) => shipped::robot_model(robot)?,
+        None => mjcf::Model::from_path(std::path::Path::new(robot))?,
+    };
     let options = CheckOptions { configs, seed };
     let report = match shipped::shipped_xml(robot) {
         Some(xml) => check_xml_str(&model, xml, robot, options)?,

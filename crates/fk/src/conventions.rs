@@ -134,6 +134,26 @@ pub const CONVENTIONS: &[Convention] = &[
         ],
     },
     Convention {
+        name: "MakeHuman",
+        source: "MakeHuman's default skeleton (Root carrying the translation, Hips beside \
+                 Spine1 carrying the legs, UpLeg_L, LoLeg_L, UpArm_L, LoArm_L)",
+        parts: &[
+            (Pelvis, &["Hips", "Root"]),
+            (Spine, &["Spine1"]),
+            (Chest, &["Spine3", "Spine2"]),
+            (Neck, &["Neck"]),
+            (Head, &["Head"]),
+            (Clavicle, &["Clavicle_{L}", "Shoulder_{L}"]),
+            (UpperArm, &["UpArm_{L}"]),
+            (Forearm, &["LoArm_{L}"]),
+            (Hand, &["Hand_{L}"]),
+            (Thigh, &["UpLeg_{L}"]),
+            (Shin, &["LoLeg_{L}"]),
+            (Foot, &["Foot_{L}"]),
+            (Toe, &["Toe_{L}"]),
+        ],
+    },
+    Convention {
         name: "Xsens MVN (segments)",
         source: "Xsens MVN exports named by segment (Pelvis, L5, L3, T12, T8, LeftShoulder = \
                  clavicle, LeftUpperArm)",

@@ -591,6 +591,11 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
     // `Bip01 Spine`, below `Bip01 Pelvis`), if close to it: not a root on the floor.
     let near = PELVIS_REACH * plan.legs[0].proximal_length;
     let mut above_pelvis: Vec<usize> = vec![plan.pelvis];
+    // Legs branching below the pelvis (MakeHuman's `Hips` under `Root`): the joints down to
+    // where they branch may be the pelvis by name too.
+    if let Some(path) = tree.path_down(plan.pelvis, plan.legs_at) {
+        above_pelvis.extend(path.into_iter().skip(1));
+    }
     let mut distance = 0.0;
     let mut at = plan.pelvis;
     while let Some(p) = tree.parents[at] {
@@ -622,7 +627,10 @@ fn trunk_roles(tree: &Tree, names: &Names, plan: &BodyPlan, roles: &mut RoleMap)
     for (role, joint) in head_and_neck(tree, names, plan, neck_at_arms) {
         roles.insert(role, joint);
     }
-    if let Some(spine) = spine(tree, names, plan, pelvis.index, chest) {
+    // The trunk runs from where the legs meet it, whichever joint the pelvis is.
+    let trunk_from =
+        if tree.is_ancestor_or_self(pelvis.index, chest) { pelvis.index } else { plan.pelvis };
+    if let Some(spine) = spine(tree, names, plan, trunk_from, chest) {
         roles.insert(Role::Spine, spine);
     }
     roles.insert(Role::Pelvis, pelvis);
@@ -943,9 +951,7 @@ fn frame_offsets(
 
 /// Head → pelvis → ankle along the bones, both legs averaged (file units).
 fn stature_path(tree: &Tree, key: &Key) -> f64 {
-    let down = |top: usize, bottom: usize| {
-        tree.path_down(top, bottom).map_or(0.0, |p| p[1..].iter().map(|&j| tree.length[j]).sum())
-    };
+    let down = |a: usize, b: usize| tree.path_length(a, b);
     let head = down(key.pelvis, key.head);
     let legs = (down(key.pelvis, key.feet[0]) + down(key.pelvis, key.feet[1])) / 2.0;
     head + legs

@@ -6,8 +6,9 @@
 #![allow(clippy::indexing_slicing)]
 
 /// Unit candidates, metres per file unit, with the name used in reports.
-const CANDIDATES: [(f64, &str); 5] = [
+const CANDIDATES: [(f64, &str); 6] = [
     (1.0, "metres"),
+    (0.1, "decimetres"),
     (0.01, "centimetres"),
     (0.001, "millimetres"),
     (0.0254, "inches"),

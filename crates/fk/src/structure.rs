@@ -4,8 +4,10 @@
 //! only, so the result holds for any rest pose.
 //!
 //! - The pelvis is a joint with two limb branches (the legs) and a third branch holding a
-//!   joint with two more limb branches (the arms) and the head. Of all such readings the one
-//!   whose limbs reach farthest wins: fingers, eyes or props form the same shape, smaller.
+//!   joint with two more limb branches (the arms) and the head; or a joint whose child
+//!   carries just the two legs, beside the trunk (MakeHuman's `Root` → `Hips` → legs, `Root`
+//!   → `Spine1`). Of all such readings the one whose limbs reach farthest wins: fingers, eyes
+//!   or props form the same shape, smaller.
 //! - A limb is followed from its junction down while it has one child, or one child that
 //!   reaches more than twice as far as the others (twist bones, heel markers); it ends at a
 //!   joint whose children are alike (the fingers of a hand) or at an End Site. Joints named
@@ -135,6 +137,28 @@ impl Tree {
         }
         path.reverse();
         Some(path)
+    }
+
+    /// Length along the bones between two joints (through their lowest common ancestor).
+    pub(crate) fn path_length(&self, a: usize, b: usize) -> f64 {
+        let mut up = vec![a];
+        while let Some(p) = self.parents[*up.last().unwrap_or(&a)] {
+            up.push(p);
+        }
+        let mut from_b = 0.0;
+        let mut at = b;
+        loop {
+            if let Some(k) = up.iter().position(|&j| j == at) {
+                return from_b + up[..k].iter().map(|&j| self.length[j]).sum::<f64>();
+            }
+            match self.parents[at] {
+                Some(p) => {
+                    from_b += self.length[at];
+                    at = p;
+                }
+                None => return 0.0,
+            }
+        }
     }
 
     /// Follow a chain down from `first` (see the module docs). Returns the joints and whether
@@ -325,6 +349,8 @@ impl Tree {
 pub(crate) struct BodyPlan {
     /// Where the legs meet the trunk.
     pub(crate) pelvis: usize,
+    /// Where the two legs branch: the pelvis, or its child that carries only them.
+    pub(crate) legs_at: usize,
     pub(crate) legs: [Limb; 2],
     /// Where the arms branch off the trunk.
     pub(crate) chest: usize,
@@ -339,6 +365,7 @@ pub(crate) struct BodyPlan {
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     pelvis: usize,
+    legs_at: usize,
     legs: [usize; 2],
     chest: usize,
     arms: [usize; 2],
@@ -364,6 +391,7 @@ impl Tree {
         };
         Some(BodyPlan {
             pelvis: c.pelvis,
+            legs_at: c.legs_at,
             legs: [leg(c.legs[0])?, leg(c.legs[1])?],
             chest: c.chest,
             arms: [arm(c.arms[0])?, arm(c.arms[1])?],
@@ -378,23 +406,35 @@ impl Tree {
         let mut out = Vec::new();
         for pelvis in 0..self.len() {
             let kids = self.kids(pelvis);
-            if self.end_site[pelvis] || kids.len() < 3 {
+            if self.end_site[pelvis] || kids.len() < 2 {
                 continue;
             }
-            for (x, &a) in kids.iter().enumerate() {
-                for &b in &kids[x + 1..] {
-                    for &t in kids.iter().filter(|&&t| t != a && t != b) {
-                        let legs = 2.0 * self.branch(a).min(self.branch(b));
-                        self.chests(pelvis, t, |chest, arms, head, up| {
-                            out.push(Candidate {
-                                pelvis,
-                                legs: [a, b],
-                                chest,
-                                arms,
-                                head,
-                                score: legs + up,
+            // Where the legs may branch: here, or in a child with just two branches.
+            let mut junctions = vec![(pelvis, kids.clone())];
+            for &k in &kids {
+                let grandkids = self.kids(k);
+                if grandkids.len() == 2 && !self.end_site[k] {
+                    junctions.push((k, grandkids));
+                }
+            }
+            for (legs_at, legs) in junctions {
+                for (x, &a) in legs.iter().enumerate() {
+                    for &b in &legs[x + 1..] {
+                        let trunks = kids.iter().filter(|&&t| t != a && t != b && t != legs_at);
+                        for &t in trunks {
+                            let reach = 2.0 * self.branch(a).min(self.branch(b));
+                            self.chests(pelvis, t, |chest, arms, head, up| {
+                                out.push(Candidate {
+                                    pelvis,
+                                    legs_at,
+                                    legs: [a, b],
+                                    chest,
+                                    arms,
+                                    head,
+                                    score: reach + up,
+                                });
                             });
-                        });
+                        }
                     }
                 }
             }

@@ -208,6 +208,46 @@ fn biped_z_up_in_inches() {
     assert!((1.45..1.53).contains(&rise), "{rise}");
 }
 
+/// MakeHuman: `Root` carries the translation, the legs hang from `Hips` beside `Spine1`
+/// (through midline helpers `__UpLeg_L`), eyes and jaw hang from `Head`; Z up in decimetres.
+/// Before, the legs-beside-the-trunk shape had no reading, and the arms were taken for legs.
+#[test]
+fn makehuman_legs_beside_the_trunk_in_decimetres() {
+    let (motion, h) =
+        own("makehuman_zup_decimetres_walk.bvh", UpAxis::PosZ, 0.1, RestPose::ArmsDown);
+    assert_eq!(h.convention, Some("MakeHuman"));
+    let m = |s: &str, parts: [&str; 4]| parts.map(|p| format!("{p}_{s}"));
+    let names = (
+        ["Hips", "Spine1", "Spine3", "Neck", "Head"].map(String::from),
+        [
+            m("L", ["Clavicle", "UpArm", "LoArm", "Hand"]),
+            m("R", ["Clavicle", "UpArm", "LoArm", "Hand"]),
+        ],
+        [m("L", ["UpLeg", "LoLeg", "Foot", "Toe"]), m("R", ["UpLeg", "LoLeg", "Foot", "Toe"])],
+    );
+    expect_owned(&h, "makehuman", &names);
+    assert_eq!(motion.num_frames, 180);
+}
+
+/// The classic 18-joint Biovision skeleton: no toe joint, inches, arms down.
+#[test]
+fn biovision_eighteen_joints_in_inches() {
+    let (_, h) = own("biovision_inches_sprint.bvh", UpAxis::PosY, 0.0254, RestPose::ArmsDown);
+    expect(
+        &h,
+        "biovision",
+        ["Hips", "-", "Chest", "Neck", "Head"],
+        [
+            ["LeftCollar", "LeftUpArm", "LeftLowArm", "LeftHand"],
+            ["RightCollar", "RightUpArm", "RightLowArm", "RightHand"],
+        ],
+        [
+            ["LeftUpLeg", "LeftLowLeg", "LeftFoot", "-"],
+            ["RightUpLeg", "RightLowLeg", "RightFoot", "-"],
+        ],
+    );
+}
+
 #[test]
 fn daz_poser_in_an_a_pose() {
     let (_, h) = own("daz_poser_apose.bvh", UpAxis::PosY, 0.01, RestPose::APose);

@@ -1,16 +1,21 @@
 //! Typed MJCF tree → [`Model`], following MuJoCo's compiler (`user_model.cc`, `user_objects.cc`):
 //! default classes with inheritance and `childclass`, angle units, orientation specifiers,
-//! `<frame>` composition, `autolimits`, joint addresses and `qpos0`; the collision filter's
-//! inputs (geom `contype`/`conaffinity`, `<contact>` excludes and pairs, `filterparent`); body
-//! mass and inertia from `<inertial>` (see `inertia`).
+//! `<frame>` composition (bodies, geoms, sites and joints), `autolimits`, joint addresses and
+//! `qpos0`; `fusestatic` (`mjCModel::FuseStatic` as 3.17 does it: every body without joints
+//! merges into its parent unless it is a mocap body or another element names it) and
+//! `alignfree` (childless free bodies in their inertial frame); mocap bodies (static, at
+//! their pose); the collision filter's inputs (geom `contype`/`conaffinity`, `<contact>`
+//! excludes and pairs, `filterparent`); body mass and inertia from `<inertial>` (see
+//! `inertia`). MuJoCo's dynamic checks (a moving body without mass) are not made: a model
+//! for retargeting needs no mass.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
 
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::error::Error;
-use crate::inertia::{self, InertiaOptions};
+use crate::inertia::{self, InertiaOptions, MJ_MINVAL, NO_MASS};
 use crate::math::{orientation_to_quat, z_to_quat};
 use crate::model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
 use crate::source::{Pos, Sources};
@@ -60,6 +65,9 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
         eulerseq: c.eulerseq.unwrap_or(*b"xyz"),
         autolimits: c.autolimits.unwrap_or(true),
         inertia: inertia_options(c),
+        fuse_static: c.fusestatic.unwrap_or(false),
+        referenced: &mjcf.referenced_bodies,
+        align_free: c.alignfree.unwrap_or(false),
         model: Model {
             name: mjcf.model_name.clone().unwrap_or_default(),
             nq: 0,
@@ -81,7 +89,15 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
         },
     };
     let main_class = mjcf.default.class.clone();
-    compiler.body(&mjcf.worldbody, 0, Frame::IDENTITY, &main_class)?;
+    let mut budget = MAX_EXPANDED;
+    let world = expand_replicates(
+        &mjcf.worldbody,
+        compiler.angle_scale,
+        compiler.eulerseq,
+        src,
+        &mut budget,
+    )?;
+    compiler.body(&world, 0, Frame::IDENTITY, &main_class)?;
     let total_mass = compiler.inertia.total_mass;
     let mut model = compiler.model;
     if let Some(total) = total_mass {
@@ -95,6 +111,107 @@ pub(crate) fn compile(mjcf: &Mjcf, src: &Sources) -> Result<Model, Error> {
     model.geom_mat = model.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
     model.site_mat = model.sites.iter().map(|s| *s.quat.to_rotation_matrix().matrix()).collect();
     Ok(model)
+}
+
+/// The body tree with every `<replicate>` turned into its copies, each a `<frame>` placing it
+/// (MuJoCo 3.17 expands them the same way before compiling: copy `i` at the `i`-th power of
+/// the replicate's frame, names suffixed).
+fn expand_replicates(
+    body: &BodySpec,
+    angle_scale: f64,
+    eulerseq: [u8; 3],
+    src: &Sources,
+    budget: &mut usize,
+) -> Result<BodySpec, Error> {
+    let mut out = body.clone();
+    out.items = expand_items(&body.items, angle_scale, eulerseq, src, budget)?;
+    Ok(out)
+}
+
+/// Items nested replicates may make in all (their product grows fast).
+const MAX_EXPANDED: usize = 1_000_000;
+
+fn expand_items(
+    items: &[Item],
+    angle_scale: f64,
+    eulerseq: [u8; 3],
+    src: &Sources,
+    budget: &mut usize,
+) -> Result<Vec<Item>, Error> {
+    let mut out = Vec::with_capacity(items.len());
+    for item in items {
+        match item {
+            Item::Body(b) => {
+                out.push(Item::Body(expand_replicates(b, angle_scale, eulerseq, src, budget)?))
+            }
+            Item::Frame(f) => {
+                out.push(Item::Frame(expand_replicates(f, angle_scale, eulerseq, src, budget)?))
+            }
+            Item::Replicate(r) => {
+                let inner = expand_items(&r.items, angle_scale, eulerseq, src, budget)?;
+                let size = inner.iter().map(item_count).sum::<usize>().max(1);
+                *budget = budget.checked_sub(size.saturating_mul(r.count)).ok_or_else(|| {
+                    src.invalid(
+                        r.pos,
+                        format!("replicates expand to more than {MAX_EXPANDED} elements"),
+                    )
+                })?;
+                let step = Frame {
+                    pos: Vector3::from(r.offset),
+                    quat: orientation_to_quat(&Orientation::Euler(r.euler), angle_scale, eulerseq)
+                        .ok_or_else(|| src.invalid(r.pos, "degenerate replicate euler"))?,
+                };
+                let digits = r.count.to_string().len();
+                let mut frame = Frame::IDENTITY;
+                for i in 0..r.count {
+                    let suffix = format!("{}{i:0digits$}", r.sep);
+                    let mut copy = inner.clone();
+                    copy.iter_mut().for_each(|item| suffix_names(item, &suffix));
+                    let q = frame.quat;
+                    out.push(Item::Frame(BodySpec {
+                        name: None,
+                        childclass: None,
+                        translation: Some(frame.pos.into()),
+                        orientation: Some((Orientation::Quat([q.w, q.i, q.j, q.k]), r.pos)),
+                        items: copy,
+                        mocap: false,
+                        pos: r.pos,
+                    }));
+                    frame = frame.compose(step.pos, step.quat);
+                }
+            }
+            other => out.push(other.clone()),
+        }
+    }
+    Ok(out)
+}
+
+/// Elements in `item`, itself included.
+fn item_count(item: &Item) -> usize {
+    1 + match item {
+        Item::Body(b) | Item::Frame(b) => b.items.iter().map(item_count).sum(),
+        Item::Replicate(r) => r.items.iter().map(item_count).sum(),
+        _ => 0,
+    }
+}
+
+/// Appends `suffix` to every name in `item` (bodies, joints, geoms, sites, and within).
+fn suffix_names(item: &mut Item, suffix: &str) {
+    let add = |name: &mut Option<String>| {
+        if let Some(n) = name.as_mut() {
+            n.push_str(suffix);
+        }
+    };
+    match item {
+        Item::Joint(j) => add(&mut j.name),
+        Item::Geom(g) | Item::Site(g) => add(&mut g.name),
+        Item::Inertial(_) => {}
+        Item::Body(b) | Item::Frame(b) => {
+            add(&mut b.name);
+            b.items.iter_mut().for_each(|i| suffix_names(i, suffix));
+        }
+        Item::Replicate(r) => r.items.iter_mut().for_each(|i| suffix_names(i, suffix)),
+    }
 }
 
 /// MuJoCo's defaults: `inertiafromgeom="auto"`, no bounds, no balancing, no total mass.
@@ -177,13 +294,35 @@ fn merge_geom(own: &GeomAttrs, base: &GeomAttrs) -> GeomAttrs {
 }
 
 /// What a body owns directly (also through `<frame>`s): joints, geoms, sites, inertials (one
-/// at most), child bodies.
+/// at most), child bodies; each with the frame it was written in, relative to the body.
 struct Contents<'a> {
-    joints: Vec<(&'a JointSpec, Option<Pos>, &'a str)>,
+    joints: Vec<(&'a JointSpec, Frame, &'a str)>,
     geoms: Vec<(&'a GeomSpec, Frame, &'a str)>,
     sites: Vec<(&'a GeomSpec, Frame, &'a str)>,
     inertials: Vec<(&'a InertialSpec, Frame)>,
     bodies: Vec<(&'a BodySpec, Frame, &'a str)>,
+}
+
+impl Contents<'_> {
+    fn new() -> Self {
+        Contents {
+            joints: Vec::new(),
+            geoms: Vec::new(),
+            sites: Vec::new(),
+            inertials: Vec::new(),
+            bodies: Vec::new(),
+        }
+    }
+}
+
+/// What is known of a body's mass while static bodies are fused into it.
+#[derive(Debug, Clone, Copy)]
+enum Mass {
+    /// Nothing with mass.
+    Zero,
+    Known(Inertial),
+    /// Taken by MuJoCo from geoms (not computed here).
+    Unknown,
 }
 
 struct Compiler<'a> {
@@ -193,12 +332,19 @@ struct Compiler<'a> {
     eulerseq: [u8; 3],
     autolimits: bool,
     inertia: InertiaOptions,
+    /// `fusestatic`, and the names it must keep.
+    fuse_static: bool,
+    referenced: &'a HashSet<String>,
+    align_free: bool,
     model: Model,
 }
 
 impl<'a> Compiler<'a> {
     /// Adds `spec` as a body with the given parent and placement, then its subtree (depth-first,
-    /// MuJoCo's body order).
+    /// MuJoCo's body order). With `fusestatic`, child bodies without joints are merged into it
+    /// first (`mjCModel::FuseStatic`): their children take their place among this body's
+    /// children, their geoms and sites follow this body's own (in depth-first order), their
+    /// mass is added to this body's.
     fn body(
         &mut self,
         spec: &'a BodySpec,
@@ -208,15 +354,17 @@ impl<'a> Compiler<'a> {
     ) -> Result<(), Error> {
         let id = self.model.bodies.len();
         let class = self.childclass(spec, class)?;
-        let mut contents = Contents {
-            joints: Vec::new(),
-            geoms: Vec::new(),
-            sites: Vec::new(),
-            inertials: Vec::new(),
-            bodies: Vec::new(),
-        };
-        self.collect(&spec.items, Frame::IDENTITY, class, None, &mut contents)?;
-        let inertial = self.inertial(&contents.inertials, id)?;
+        let mut contents = Contents::new();
+        self.collect(&spec.items, Frame::IDENTITY, class, &mut contents)?;
+        if spec.mocap && (parent != 0 || !contents.joints.is_empty()) {
+            return Err(self.src.invalid(
+                spec.pos,
+                "a mocap body must be a child of the world and have no joints",
+            ));
+        }
+        let mut mass = self.mass(&contents, id)?;
+        let children = std::mem::take(&mut contents.bodies);
+        let children = self.fuse(children, id, &mut contents, &mut mass)?;
         self.model.bodies.push(Body {
             name: spec.name.clone().unwrap_or_default(),
             parent,
@@ -226,16 +374,16 @@ impl<'a> Compiler<'a> {
             jnt_num: contents.joints.len(),
             dof_adr: self.model.nv,
             dof_num: 0,
-            inertial,
+            inertial: match mass {
+                Mass::Known(i) if id != 0 => Some(i),
+                _ => None,
+            },
         });
         let parent_last_dof =
             if id == 0 { None } else { self.model.body_last_dof.get(parent).copied().flatten() };
         self.model.body_last_dof.push(parent_last_dof);
-        for (joint, frame_pos, class) in &contents.joints {
-            if let Some(at) = frame_pos {
-                return Err(self.src.unsupported(*at, "joint inside <frame>"));
-            }
-            self.joint(joint, id, class)?;
+        for (joint, frame, class) in &contents.joints {
+            self.joint(joint, id, *frame, class)?;
         }
         for (geom, frame, class) in &contents.geoms {
             let geom = self.geom(geom, id, *frame, class, false)?;
@@ -246,12 +394,89 @@ impl<'a> Compiler<'a> {
             let Geom { name, body, kind, size, pos, quat, .. } = geom;
             self.model.sites.push(Site { name, body, kind, size, pos, quat });
         }
-        for (child, frame, class) in contents.bodies {
+        let align = contents.joints.iter().any(|(j, _, _)| {
+            j.attrs.kind == Some(JointType::Free) && j.align.unwrap_or(self.align_free)
+        });
+        if align && children.is_empty() {
+            self.model.align_to_inertia(id);
+        }
+        for (child, frame, class) in children {
             let pos = Vector3::from(child.translation.unwrap_or_default());
             let quat = self.orientation(child.orientation.as_ref())?;
             self.body(child, id, frame.compose(pos, quat), class)?;
         }
         Ok(())
+    }
+
+    /// The body's own mass: its `<inertial>` compiled, else nothing (no geoms) or unknown.
+    fn mass(&self, contents: &Contents<'a>, id: usize) -> Result<Mass, Error> {
+        Ok(match self.inertial(&contents.inertials, id)? {
+            Some(i) => Mass::Known(i),
+            None if contents.geoms.is_empty() && contents.inertials.is_empty() => Mass::Zero,
+            None => Mass::Unknown,
+        })
+    }
+
+    /// `fusestatic`: of `children` (placed in body `id`), merges those without joints (not
+    /// mocap, not named by another element) into `contents` and `mass`; returns the bodies
+    /// that stay, in MuJoCo's order.
+    fn fuse(
+        &self,
+        children: Vec<(&'a BodySpec, Frame, &'a str)>,
+        id: usize,
+        contents: &mut Contents<'a>,
+        mass: &mut Mass,
+    ) -> Result<Vec<(&'a BodySpec, Frame, &'a str)>, Error> {
+        if !self.fuse_static {
+            return Ok(children);
+        }
+        let mut queue: std::collections::VecDeque<_> = children.into();
+        let mut kept = Vec::new();
+        while let Some((child, frame, class)) = queue.pop_front() {
+            let pos = Vector3::from(child.translation.unwrap_or_default());
+            let at = frame.compose(pos, self.orientation(child.orientation.as_ref())?);
+            let inner = self.childclass(child, class)?;
+            let mut own = Contents::new();
+            self.collect(&child.items, at, inner, &mut own)?;
+            let named = child.name.as_ref().is_some_and(|n| self.referenced.contains(n));
+            if !own.joints.is_empty() || child.mocap || named {
+                kept.push((child, frame, class));
+                continue;
+            }
+            let added = self.mass(&own, id)?;
+            *mass = self.add_mass(*mass, added, child, id)?;
+            contents.geoms.append(&mut own.geoms);
+            contents.sites.append(&mut own.sites);
+            // The fused body's children come next, in its place (MuJoCo inserts them there).
+            for grandchild in own.bodies.into_iter().rev() {
+                queue.push_front(grandchild);
+            }
+        }
+        Ok(kept)
+    }
+
+    /// `mjCModel::FuseStatic`'s mass: bodies lighter than `mjMINVAL` add nothing, nothing
+    /// is added to the world.
+    fn add_mass(
+        &self,
+        into: Mass,
+        added: Mass,
+        child: &BodySpec,
+        id: usize,
+    ) -> Result<Mass, Error> {
+        let combined = |a: &Inertial, b: &Inertial| {
+            inertia::combine(a, b).map_err(|e| {
+                self.src.invalid(child.pos, format!("error '{e}' in fusing static body inertias"))
+            })
+        };
+        Ok(match (into, added) {
+            _ if id == 0 => into,
+            (into, Mass::Zero) => into,
+            (Mass::Unknown, _) | (_, Mass::Unknown) => Mass::Unknown,
+            (into, Mass::Known(i)) if i.mass < MJ_MINVAL => into,
+            (Mass::Zero, Mass::Known(i)) => Mass::Known(combined(&NO_MASS, &i)?),
+            (Mass::Known(a), Mass::Known(b)) => Mass::Known(combined(&a, &b)?),
+        })
     }
 
     fn childclass(&self, spec: &'a BodySpec, inherited: &'a str) -> Result<&'a str, Error> {
@@ -269,12 +494,11 @@ impl<'a> Compiler<'a> {
         items: &'a [Item],
         frame: Frame,
         class: &'a str,
-        in_frame: Option<Pos>,
         out: &mut Contents<'a>,
     ) -> Result<(), Error> {
         for item in items {
             match item {
-                Item::Joint(j) => out.joints.push((j, in_frame, class)),
+                Item::Joint(j) => out.joints.push((j, frame, class)),
                 Item::Geom(g) => out.geoms.push((g, frame, class)),
                 Item::Site(s) => out.sites.push((s, frame, class)),
                 Item::Inertial(i) => out.inertials.push((i, frame)),
@@ -283,8 +507,10 @@ impl<'a> Compiler<'a> {
                     let pos = Vector3::from(f.translation.unwrap_or_default());
                     let quat = self.orientation(f.orientation.as_ref())?;
                     let inner = self.childclass(f, class)?;
-                    self.collect(&f.items, frame.compose(pos, quat), inner, Some(f.pos), out)?;
+                    self.collect(&f.items, frame.compose(pos, quat), inner, out)?;
                 }
+                // Expanded into frames before compiling (`expand_replicates`).
+                Item::Replicate(_) => {}
             }
         }
         Ok(())
@@ -351,7 +577,13 @@ impl<'a> Compiler<'a> {
 
     // `body` and its parent are ids this builder assigned (the body being compiled).
     #[allow(clippy::indexing_slicing)]
-    fn joint(&mut self, spec: &JointSpec, body: usize, class: &str) -> Result<(), Error> {
+    fn joint(
+        &mut self,
+        spec: &JointSpec,
+        body: usize,
+        frame: Frame,
+        class: &str,
+    ) -> Result<(), Error> {
         let attrs = if spec.is_freejoint {
             spec.attrs.clone()
         } else {
@@ -360,12 +592,13 @@ impl<'a> Compiler<'a> {
         let kind = attrs.kind.unwrap_or(JointType::Hinge);
         let parent = self.model.bodies[body].parent;
         if kind == JointType::Free && (parent != 0 || self.model.bodies[body].jnt_num != 1) {
+            // MuJoCo 3.17 refuses both.
             let what = if parent != 0 {
-                "a free joint in a body that is not a child of the world"
+                "free joint can only be used on top level"
             } else {
-                "a free joint together with other joints in one body"
+                "a free joint together with other joints in one body (more than 6 dofs)"
             };
-            return Err(self.src.unsupported(spec.pos, what));
+            return Err(self.src.invalid(spec.pos, what));
         }
         let axis = match kind {
             JointType::Hinge | JointType::Slide => {
@@ -374,7 +607,8 @@ impl<'a> Compiler<'a> {
                 if n < 1e-10 {
                     return Err(self.src.invalid(spec.pos, "joint axis has zero length"));
                 }
-                a / n
+                // A joint inside a <frame> is placed by it, axis and anchor.
+                frame.quat * (a / n)
             }
             JointType::Ball | JointType::Free => Vector3::z(),
         };
@@ -387,7 +621,7 @@ impl<'a> Compiler<'a> {
             dof_adr: self.model.nv,
             range,
             axis,
-            pos: Vector3::from(attrs.pos.unwrap_or_default()),
+            pos: frame.pos + frame.quat * Vector3::from(attrs.pos.unwrap_or_default()),
             velocity_limit: None,
         };
         self.push_qpos0(&joint, &attrs);
@@ -716,5 +950,126 @@ mod tests {
         assert_eq!(names, ["world", "a", "a1", "a2", "b"]);
         let joints: Vec<_> = m.joints.iter().map(|j| (j.name.as_str(), j.body)).collect();
         assert_eq!(joints, [("ja", 1), ("ja1", 2)]);
+    }
+
+    #[test]
+    fn coordinate_local_is_read_and_global_refused_as_mujoco_does() {
+        let xml = |c: &str| {
+            format!(
+                r#"<mujoco><compiler coordinate="{c}" angle="degree"/><worldbody>
+                   <body name="a" pos="0 0 1"><joint axis="0 1 0" range="-90 90"/>
+                   <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom size="0.1"/></body>
+                   </worldbody></mujoco>"#
+            )
+        };
+        let m = model(&xml("local"));
+        assert_eq!(m.joints[0].range, Some([-FRAC_PI_2, FRAC_PI_2]));
+        matches_mujoco(&m, &xml("local"), 1);
+        let err = Model::from_xml_str(&xml("global"), None).unwrap_err().to_string();
+        assert!(err.contains("global coordinates no longer supported"), "{err}");
+        assert!(err.starts_with("<string>:1:"), "{err}");
+    }
+
+    #[test]
+    fn joints_inside_frames_are_placed_by_them() {
+        let xml = r#"<mujoco><worldbody><body name="a" pos="0 0 1">
+              <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom size="0.1"/>
+              <frame pos="0.1 0.2 0.3" euler="0 0 90"><joint name="j" pos="0.5 0 0" axis="1 0 0"/></frame>
+              <body name="b" pos="0 0 0.5"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+                <geom size="0.1"/><frame euler="90 0 0"><joint name="k" type="ball"/></frame></body>
+            </body></worldbody></mujoco>"#;
+        let m = model(xml);
+        let j = &m.joints[0];
+        assert!((j.pos - Vector3::new(0.1, 0.7, 0.3)).norm() < 1e-12, "{}", j.pos);
+        assert!((j.axis - Vector3::y()).norm() < 1e-12, "{}", j.axis);
+        matches_mujoco(&m, xml, 2);
+    }
+
+    /// `fusestatic` as MuJoCo 3.17 does it: jointless bodies merge into their parents unless
+    /// another element names them; their children take their place, their geoms follow the
+    /// parent's own, their mass adds to the parent's.
+    #[test]
+    fn fusestatic_merges_jointless_bodies() {
+        let xml = |refs: &str| {
+            format!(
+                r#"<mujoco><compiler fusestatic="true"/><worldbody>
+                 <body name="a" pos="0 0 1"><joint name="ja" axis="0 1 0"/>
+                   <inertial pos="0 0 0" mass="2" diaginertia="0.1 0.1 0.1"/>
+                   <body name="b" pos="0 0 0.5" euler="0 0 90"><geom name="gb" type="box" size="0.1 0.2 0.3"/>
+                     <inertial pos="0.1 0 0" mass="1" diaginertia="0.01 0.02 0.03"/>
+                     <body name="c" pos="0 0.2 0"><joint name="jc"/><geom name="gc" size="0.1"/>
+                       <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+                     <body name="d" pos="0.3 0 0"><site name="sd"/></body>
+                   </body>
+                   <geom name="ga" size="0.05"/>
+                   <body name="e" pos="0 0 -0.5"><joint name="je"/>
+                     <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+                 </body>
+                 <body name="s" pos="1 0 0"><geom name="gs" size="0.1"/></body>
+               </worldbody>{refs}</mujoco>"#
+            )
+        };
+        let m = model(&xml(""));
+        let names: Vec<_> = m.bodies.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["world", "a", "c", "e"]);
+        let geoms: Vec<_> = m.geoms.iter().map(|g| (g.name.as_str(), g.body)).collect();
+        assert_eq!(geoms, [("gs", 0), ("ga", 1), ("gb", 1), ("gc", 2)]);
+        let c = &m.bodies[2];
+        assert!((c.pos - Vector3::new(-0.2, 0.0, 0.5)).norm() < 1e-12, "{}", c.pos);
+        assert_eq!(m.sites[0].body, 1);
+        assert!((inertial(&m, "a").mass - 3.0).abs() < 1e-15);
+        matches_mujoco(&m, &xml(""), 3);
+        // Named by a sensor or an exclude, a body stays.
+        let refs = r#"<sensor><framepos objtype="body" objname="d"/></sensor>
+                      <contact><exclude body1="s" body2="a"/></contact>"#;
+        let m = model(&xml(refs));
+        let names: Vec<_> = m.bodies.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["world", "a", "c", "d", "e", "s"]);
+        matches_mujoco(&m, &xml(refs), 3);
+    }
+
+    #[test]
+    fn mocap_bodies_are_static_and_alignfree_moves_childless_free_bodies() {
+        let xml = r#"<mujoco><compiler alignfree="true"/><worldbody>
+              <body name="m" mocap="true" pos="0 0 1"><geom size="0.1" contype="0" conaffinity="0"/></body>
+              <body name="box" pos="1 0 0" euler="0 0 30"><freejoint/><geom type="box" size="0.1 0.2 0.3"/>
+                <inertial pos="0.1 0.2 0.3" euler="10 20 30" mass="1" diaginertia="0.1 0.2 0.25"/>
+                <site name="s" pos="0.1 0 0"/></body>
+              <body name="robot" pos="0 1 1"><freejoint/>
+                <inertial pos="0.1 0 0" mass="1" diaginertia="1 1 1"/><geom size="0.1"/>
+                <body name="arm"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+              </body>
+            </worldbody></mujoco>"#;
+        let m = model(xml);
+        assert_eq!(m.bodies.len(), 5);
+        let b = &m.bodies[m.body_id("box").unwrap()];
+        assert!(b.inertial.unwrap().pos.norm() < 1e-15);
+        // The robot's body frame stays: it has a child.
+        assert_eq!(m.bodies[m.body_id("robot").unwrap()].pos, Vector3::new(0.0, 1.0, 1.0));
+        matches_mujoco(&m, xml, 3);
+        let bad = r#"<mujoco><worldbody><body><body mocap="true"/></body></worldbody></mujoco>"#;
+        let err = Model::from_xml_str(bad, None).unwrap_err().to_string();
+        assert!(err.contains("mocap body must be a child of the world"), "{err}");
+    }
+
+    /// `<replicate>` as MuJoCo 3.17 expands it: copy `i` at the `i`-th power of its frame,
+    /// names suffixed by `sep` and `i` padded to the digits of `count`, inner suffixes first.
+    #[test]
+    fn replicate_copies_its_children() {
+        let xml = r#"<mujoco><worldbody><body name="base"><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+              <replicate count="3" offset="0 0.2 0" euler="0 0 30" sep="-">
+                <body name="a" pos="1 0 0"><joint name="j"/><geom name="g" size="0.1"/>
+                  <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></replicate></body>
+              <replicate count="2" offset="1 0 0" sep="o"><replicate count="12" offset="0 0.2 0" sep="i">
+                <body name="c"><joint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+              </replicate></replicate></worldbody></mujoco>"#;
+        let m = model(xml);
+        let names: Vec<_> = m.bodies.iter().map(|b| b.name.as_str()).take(6).collect();
+        assert_eq!(names, ["world", "base", "a-0", "a-1", "a-2", "ci00o0"]);
+        assert_eq!(m.bodies.len(), 2 + 3 + 24);
+        let a2 = &m.bodies[4];
+        assert!((a2.pos - Vector3::new(0.4, 1.2392304845413262, 0.0)).norm() < 1e-12, "{}", a2.pos);
+        assert_eq!(m.joints[2].name, "j-2");
+        matches_mujoco(&m, xml, 28);
     }
 }

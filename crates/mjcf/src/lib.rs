@@ -53,7 +53,7 @@ pub use collision::{
 pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;
-pub use model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
+pub use model::{Body, FloatingBase, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
 pub use urdf::{UrdfBase, UrdfOptions};
 
 impl Model {

@@ -291,3 +291,165 @@ impl Model {
         self.dof_joint[dof]
     }
 }
+
+impl Model {
+    /// `alignfree`: a free body without children gets its inertial frame as its body frame
+    /// (geoms and sites re-expressed in it, `qpos0` the new pose). A body whose inertia MuJoCo
+    /// takes from its geoms is left as it is (its inertial frame is not computed here).
+    pub(crate) fn align_to_inertia(&mut self, id: usize) {
+        let Some(body) = self.bodies.get_mut(id) else { return };
+        let Some(i) = body.inertial else { return };
+        let (pos, quat) = (body.pos + body.quat * i.pos, body.quat * i.quat);
+        let inverse = i.quat.inverse();
+        body.pos = pos;
+        body.quat = quat;
+        body.inertial =
+            Some(Inertial { pos: Vector3::zeros(), quat: UnitQuaternion::identity(), ..i });
+        for g in self.geoms.iter_mut().filter(|g| g.body == id) {
+            g.pos = inverse * (g.pos - i.pos);
+            g.quat = inverse * g.quat;
+        }
+        for s in self.sites.iter_mut().filter(|s| s.body == id) {
+            s.pos = inverse * (s.pos - i.pos);
+            s.quat = inverse * s.quat;
+        }
+        for j in self.joints.iter().filter(|j| j.body == id && j.kind == JointType::Free) {
+            let a = j.qpos_adr;
+            if let Some(q) = self.qpos0.get_mut(a..a + 7) {
+                q.copy_from_slice(&[pos.x, pos.y, pos.z, quat.w, quat.i, quat.j, quat.k]);
+            }
+        }
+    }
+}
+
+/// The free joint [`Model::add_floating_base`] gave a model without one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloatingBase {
+    /// The body that carries it.
+    pub body: usize,
+    /// Its name: `<body>_free_joint`, as MuJoCo names the one it adds to a URDF's root link.
+    pub joint: String,
+}
+
+impl Model {
+    /// Whether some joint is free (a floating base).
+    #[must_use]
+    pub fn has_free_joint(&self) -> bool {
+        self.joints.iter().any(|j| j.kind == JointType::Free)
+    }
+
+    /// The body that holds the robot: the child of the world whose subtree has the most
+    /// joints (the first of equals); `None` when no child of the world has a jointless body
+    /// of its own at the top (a free joint needs a body without other joints).
+    #[must_use]
+    pub fn root_body(&self) -> Option<usize> {
+        let mut joints_below = vec![0usize; self.bodies.len()];
+        for b in (1..self.bodies.len()).rev() {
+            let body = self.bodies.get(b)?;
+            let own = body.jnt_num + joints_below.get(b).copied().unwrap_or(0);
+            if let Some(j) = joints_below.get_mut(b) {
+                *j = own;
+            }
+            if body.parent != b {
+                if let Some(p) = joints_below.get_mut(body.parent).filter(|_| body.parent != 0) {
+                    *p += own;
+                }
+            }
+        }
+        (1..self.bodies.len())
+            .filter(|&b| self.bodies.get(b).is_some_and(|body| body.parent == 0))
+            .max_by_key(|&b| (joints_below.get(b).copied().unwrap_or(0), std::cmp::Reverse(b)))
+            .filter(|&b| self.bodies.get(b).is_some_and(|body| body.jnt_num == 0))
+    }
+
+    /// A floating base for a model without one (MJCF whose free joint the user's code adds,
+    /// dm_control style; a URDF read with [`crate::UrdfBase::Fixed`]): a free joint on
+    /// [`Model::root_body`], placed at `pos`, `quat` in the world (its `qpos0` and the body's
+    /// frame, as MuJoCo makes a free body's). `None` when the model has a free joint already
+    /// or no such root body. Joints, dofs and `qpos` after it move up, as if it had been
+    /// written in the file.
+    pub fn add_floating_base(
+        &mut self,
+        pos: Vector3<f64>,
+        quat: UnitQuaternion<f64>,
+    ) -> Option<FloatingBase> {
+        if self.has_free_joint() {
+            return None;
+        }
+        let body = self.root_body()?;
+        let name = match self.bodies.get(body).map(|b| b.name.as_str()) {
+            Some("") | None => format!("body{body}_free_joint"),
+            Some(n) => format!("{n}_free_joint"),
+        };
+        // Each joint's qpos0, to lay them out again.
+        let mut values: Vec<Vec<f64>> = self
+            .joints
+            .iter()
+            .map(|j| {
+                self.qpos0.get(j.qpos_adr..j.qpos_adr + j.kind.nq()).unwrap_or_default().to_vec()
+            })
+            .collect();
+        let at = self.bodies.get(body)?.jnt_adr;
+        let free = Joint {
+            name: name.clone(),
+            kind: JointType::Free,
+            body,
+            qpos_adr: 0,
+            dof_adr: 0,
+            range: None,
+            axis: Vector3::z(),
+            pos: Vector3::zeros(),
+            velocity_limit: None,
+        };
+        self.joints.insert(at, free);
+        values.insert(at, vec![pos.x, pos.y, pos.z, quat.w, quat.i, quat.j, quat.k]);
+        if let Some(b) = self.bodies.get_mut(body) {
+            b.pos = pos;
+            b.quat = quat;
+        }
+        self.lay_out_joints(&values);
+        Some(FloatingBase { body, joint: name })
+    }
+
+    /// Addresses of joints, dofs and `qpos` from the joint list (joints grouped by body in
+    /// body order), with `values[j]` the `qpos0` of joint `j`.
+    fn lay_out_joints(&mut self, values: &[Vec<f64>]) {
+        let (mut nq, mut nv) = (0, 0);
+        self.qpos0.clear();
+        self.dof_joint.clear();
+        self.dof_parent.clear();
+        self.body_last_dof = vec![None; self.bodies.len()];
+        let mut next_joint = 0;
+        for b in 0..self.bodies.len() {
+            let parent = self.bodies.get(b).map_or(0, |body| body.parent);
+            let mut last =
+                if b == 0 { None } else { self.body_last_dof.get(parent).copied().flatten() };
+            let (jnt_adr, dof_adr) = (next_joint, nv);
+            while let Some(joint) = self.joints.get_mut(next_joint).filter(|j| j.body == b) {
+                joint.qpos_adr = nq;
+                joint.dof_adr = nv;
+                nq += joint.kind.nq();
+                for _ in 0..joint.kind.nv() {
+                    self.dof_joint.push(next_joint);
+                    self.dof_parent.push(last);
+                    last = Some(nv);
+                    nv += 1;
+                }
+                self.qpos0.extend(values.get(next_joint).into_iter().flatten());
+                next_joint += 1;
+            }
+            if let Some(slot) = self.body_last_dof.get_mut(b) {
+                *slot = last;
+            }
+            if let Some(body) = self.bodies.get_mut(b) {
+                body.jnt_adr = jnt_adr;
+                body.jnt_num = next_joint - jnt_adr;
+                body.dof_adr = dof_adr;
+                body.dof_num = nv - dof_adr;
+            }
+        }
+        self.nq = nq;
+        self.nv = nv;
+        self.jnt_pos_zero = self.joints.iter().map(|j| j.pos == Vector3::zeros()).collect();
+    }
+}

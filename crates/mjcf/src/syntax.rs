@@ -2,10 +2,16 @@
 //! class, unit or frame is applied (that is `compile`'s job). Only the parts that matter for
 //! kinematics and collision filtering are kept (geom `contype`/`conaffinity`, `<contact>`'s
 //! `<exclude>` and `<pair>`, `<option><flag filterparent>`), plus `<inertial>` and the
-//! `<compiler>` attributes that change it; elements that cannot change a body pose or which
-//! geoms may collide (actuators, sensors, assets, visual, ...) are skipped, and elements that
-//! would change one but are not implemented are an
+//! `<compiler>` attributes that change it or the body tree (`fusestatic`, `alignfree`), and
+//! the names other elements give bodies (a body named there is never fused). Elements that
+//! cannot change a body pose or which geoms may collide (actuators, sensors, assets, visual,
+//! ...) are skipped; so are the `<compiler>` attributes MuJoCo 3.17 reads that change
+//! neither (`meshdir`, `strippath`, `discardvisual`, `usethread`, the deprecated
+//! `coordinate="local"`, ...; `coordinate="global"` is MuJoCo's error). Elements that would
+//! change a pose but are not implemented are an
 //! [`Error::Unsupported`](crate::Error::Unsupported).
+
+use std::collections::HashSet;
 
 use crate::error::Error;
 use crate::model::{GeomType, JointType};
@@ -29,6 +35,10 @@ pub(crate) struct CompilerSpec {
     pub boundinertia: Option<f64>,
     pub balanceinertia: Option<bool>,
     pub settotalmass: Option<f64>,
+    /// `fusestatic`: bodies without joints merged into their parents (MuJoCo's default: no).
+    pub fusestatic: Option<bool>,
+    /// `alignfree`: childless free bodies moved to their inertial frame (default: no).
+    pub alignfree: Option<bool>,
 }
 
 /// One orientation specifier as written (units and sequence resolved by `compile`).
@@ -90,6 +100,9 @@ pub(crate) struct JointSpec {
     pub attrs: JointAttrs,
     /// `<freejoint>` (ignores defaults).
     pub is_freejoint: bool,
+    /// `align` of a free joint: `Some` when written `true`/`false`, `None` for `auto` (the
+    /// compiler's `alignfree` decides).
+    pub align: Option<bool>,
     pub pos: Pos,
 }
 
@@ -127,6 +140,20 @@ pub(crate) enum Item {
     Inertial(InertialSpec),
     Body(BodySpec),
     Frame(BodySpec),
+    Replicate(ReplicateSpec),
+}
+
+/// `<replicate count offset euler sep>`: its children `count` times, copy `i` placed by the
+/// `i`-th power of the frame (`offset`, `euler`), every name in it suffixed by `sep` and `i`
+/// (zero-padded to the digits of `count`), as MuJoCo 3.17 expands it.
+#[derive(Debug, Clone)]
+pub(crate) struct ReplicateSpec {
+    pub count: usize,
+    pub offset: [f64; 3],
+    pub euler: [f64; 3],
+    pub sep: String,
+    pub items: Vec<Item>,
+    pub pos: Pos,
 }
 
 /// A `<body>`, a `<frame>` or the `<worldbody>` (name `world`).
@@ -137,6 +164,8 @@ pub(crate) struct BodySpec {
     pub translation: Option<[f64; 3]>,
     pub orientation: Option<(Orientation, Pos)>,
     pub items: Vec<Item>,
+    /// `mocap="true"`: a static body placed by `mocap_pos` (its own pose at `qpos0`).
+    pub mocap: bool,
     pub pos: Pos,
 }
 
@@ -163,6 +192,10 @@ pub(crate) struct Mjcf {
     pub contact: ContactSpec,
     /// `<option><flag filterparent>`: `None` when not written (MuJoCo's default: enabled).
     pub filterparent: Option<bool>,
+    /// Names that some element refers to as a body (`body`, `body1`, `body2`, `target`,
+    /// `objname`, `refname` attributes anywhere in the file): MuJoCo's `fusestatic` keeps
+    /// such a body.
+    pub referenced_bodies: HashSet<String>,
 }
 
 /// Top-level sections that cannot change body poses or collision filtering: skipped.
@@ -202,11 +235,14 @@ pub(crate) fn parse(root: &Element, src: &Sources) -> Result<Mjcf, Error> {
             translation: None,
             orientation: None,
             items: Vec::new(),
+            mocap: false,
             pos: root.pos,
         },
         contact: ContactSpec::default(),
         filterparent: None,
+        referenced_bodies: HashSet::new(),
     };
+    collect_body_references(root, &mut mjcf.referenced_bodies);
     for el in &root.children {
         match el.name.as_str() {
             "compiler" => parse_compiler(el, src, &mut mjcf.compiler)?,
@@ -247,19 +283,36 @@ fn parse_compiler(el: &Element, src: &Sources, c: &mut CompilerSpec) -> Result<(
             "boundinertia" => c.boundinertia = Some(floats::<1>(a, src)?[0]),
             "balanceinertia" => c.balanceinertia = Some(boolean(a, src)?),
             "settotalmass" => c.settotalmass = Some(floats::<1>(a, src)?[0]),
-            "fusestatic" | "alignfree" if boolean(a, src)? => {
-                return Err(src.unsupported(
-                    a.pos,
-                    format!("<compiler {}=\"true\"> (changes the body tree)", a.name),
-                ));
-            }
-            "coordinate" => {
-                return Err(src.unsupported(a.pos, "<compiler coordinate> (removed from MuJoCo)"))
-            }
+            "fusestatic" => c.fusestatic = Some(boolean(a, src)?),
+            "alignfree" => c.alignfree = Some(boolean(a, src)?),
+            // Deprecated and still read by MuJoCo 3.17: `local` is the only meaning left.
+            "coordinate" if keyword(a, src, &[("local", true), ("global", false)])? => {}
+            "coordinate" => return Err(src.invalid(a.pos, GLOBAL_COORDINATES)),
+            // Everything else MuJoCo reads here changes no body pose (meshdir, strippath,
+            // discardvisual, usethread, fitaabb, lengthrange, ...): read and ignored.
             _ => {}
         }
     }
     Ok(())
+}
+
+/// MuJoCo 3.17's error for `<compiler coordinate="global">`.
+pub(crate) const GLOBAL_COORDINATES: &str = "global coordinates no longer supported. To convert \
+     existing models, load and save them in MuJoCo 2.3.3 or older";
+
+/// Attributes whose value names a body (sensors, equalities, excludes, lights, cameras,
+/// adhesion actuators).
+const BODY_REFERENCES: &[&str] = &["body", "body1", "body2", "target", "objname", "refname"];
+
+fn collect_body_references(el: &Element, out: &mut HashSet<String>) {
+    for a in &el.attrs {
+        if BODY_REFERENCES.contains(&a.name.as_str()) {
+            out.insert(a.value.clone());
+        }
+    }
+    for child in &el.children {
+        collect_body_references(child, out);
+    }
 }
 
 /// `<option>`: only `<flag filterparent="enable|disable">` matters here (the last one wins,
@@ -337,6 +390,7 @@ fn parse_item(el: &Element, src: &Sources, in_world: bool) -> Result<Option<Item
     let item = match el.name.as_str() {
         "body" => Item::Body(parse_body(el, src)?),
         "frame" => Item::Frame(parse_body(el, src)?),
+        "replicate" => Item::Replicate(parse_replicate(el, src, in_world)?),
         "joint" | "freejoint" if in_world => {
             return Err(src.invalid(el.pos, format!("<{}> directly in <worldbody>", el.name)));
         }
@@ -355,15 +409,14 @@ fn parse_item(el: &Element, src: &Sources, in_world: bool) -> Result<Option<Item
 }
 
 fn parse_body(el: &Element, src: &Sources) -> Result<BodySpec, Error> {
-    if let Some(a) = el.attr("mocap").filter(|a| a.value == "true") {
-        return Err(src.unsupported(a.pos, "mocap bodies"));
-    }
+    let mocap = el.attr("mocap").map(|a| boolean(a, src)).transpose()?.unwrap_or(false);
     let mut body = BodySpec {
         name: el.attr("name").map(|a| a.value.clone()),
         childclass: el.attr("childclass").map(|a| (a.value.clone(), a.pos)),
         translation: el.attr("pos").map(|a| floats::<3>(a, src)).transpose()?,
         orientation: orientation(el, src)?,
         items: Vec::new(),
+        mocap,
         pos: el.pos,
     };
     for child in &el.children {
@@ -374,27 +427,61 @@ fn parse_body(el: &Element, src: &Sources) -> Result<BodySpec, Error> {
     Ok(body)
 }
 
+fn parse_replicate(el: &Element, src: &Sources, in_world: bool) -> Result<ReplicateSpec, Error> {
+    let count_attr = el
+        .attr("count")
+        .ok_or_else(|| src.invalid(el.pos, "<replicate> needs the attribute count"))?;
+    let count = usize::try_from(int(count_attr, src)?)
+        .ok()
+        .filter(|c| (1..=MAX_REPLICATE).contains(c))
+        .ok_or_else(|| {
+            src.invalid(count_attr.pos, format!("replicate count must be 1 to {MAX_REPLICATE}"))
+        })?;
+    let mut spec = ReplicateSpec {
+        count,
+        offset: el.attr("offset").map(|a| floats::<3>(a, src)).transpose()?.unwrap_or_default(),
+        euler: el.attr("euler").map(|a| floats::<3>(a, src)).transpose()?.unwrap_or_default(),
+        sep: el.attr("sep").map(|a| a.value.clone()).unwrap_or_default(),
+        items: Vec::new(),
+        pos: el.pos,
+    };
+    for child in &el.children {
+        if let Some(item) = parse_item(child, src, in_world)? {
+            spec.items.push(item);
+        }
+    }
+    Ok(spec)
+}
+
+/// Copies one `<replicate>` may make (each a copy of its subtree: the file's size bounds it).
+const MAX_REPLICATE: usize = 10_000;
+
 fn parse_joint(el: &Element, src: &Sources) -> Result<JointSpec, Error> {
     Ok(JointSpec {
         name: el.attr("name").map(|a| a.value.clone()),
         class: el.attr("class").map(|a| (a.value.clone(), a.pos)),
         attrs: joint_attrs(el, src)?,
         is_freejoint: false,
+        align: align(el, src)?,
         pos: el.pos,
     })
 }
 
 fn parse_freejoint(el: &Element, src: &Sources) -> Result<JointSpec, Error> {
-    if let Some(a) = el.attr("align").filter(|a| a.value == "true") {
-        return Err(src.unsupported(a.pos, "<freejoint align=\"true\"> (moves the body frame)"));
-    }
     Ok(JointSpec {
         name: el.attr("name").map(|a| a.value.clone()),
         class: None,
         attrs: JointAttrs { kind: Some(JointType::Free), ..JointAttrs::default() },
         is_freejoint: true,
+        align: align(el, src)?,
         pos: el.pos,
     })
+}
+
+/// `align="false|true|auto"` of a free joint (`auto`: as the compiler's `alignfree` says).
+fn align(el: &Element, src: &Sources) -> Result<Option<bool>, Error> {
+    let options = [("false", Some(false)), ("true", Some(true)), ("auto", None)];
+    Ok(el.attr("align").map(|a| keyword(a, src, &options)).transpose()?.flatten())
 }
 
 fn parse_geom(el: &Element, src: &Sources) -> Result<GeomSpec, Error> {
@@ -473,9 +560,6 @@ fn joint_attrs(el: &Element, src: &Sources) -> Result<JointAttrs, Error> {
                 j.limited = Some(keyword(a, src, &options)?);
             }
             "ref" => j.reference = Some(floats::<1>(a, src)?[0]),
-            "align" if a.value == "true" => {
-                return Err(src.unsupported(a.pos, "joint align=\"true\""))
-            }
             _ => {}
         }
     }

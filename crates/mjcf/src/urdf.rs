@@ -38,8 +38,18 @@
 //!   or a fused one without `<inertial>` but with collisions, unless `inertiafromgeom="false"`),
 //!   and for every body with `inertiafromgeom="true"`, `boundmass` or `boundinertia` (which
 //!   MuJoCo applies to every link before fusing, massless ones included).
-//! - `<visual>` is discarded (MuJoCo's URDF default `discardvisual="true"`); dynamics, effort,
-//!   mimic, transmissions, materials and gazebo tags do not change kinematics and are skipped.
+//! - `<visual>` is discarded (MuJoCo's URDF default `discardvisual="true"`); with
+//!   `<mujoco><compiler discardvisual="false">` each becomes a geom that never collides
+//!   (`contype = conaffinity = 0`, MuJoCo's visual geoms), among the collisions in the order
+//!   written. Dynamics, effort, mimic, transmissions, materials and gazebo tags do not change
+//!   kinematics and are skipped.
+//! - `<mujoco>` (MuJoCo's extension, read before the links wherever it is written): its
+//!   `<compiler>` takes every attribute MuJoCo's does, with MuJoCo's meaning: `fusestatic`,
+//!   `discardvisual`, `alignfree`, `autolimits` (`false` refuses a joint with a range, as
+//!   MuJoCo does), the inertia attributes below; `coordinate="global"` is MuJoCo's error;
+//!   `angle` and `eulerseq` change nothing (MuJoCo forces radians on URDF and reads `rpy` as
+//!   `XYZ`), nor do `meshdir`, `strippath` and the rest (no mesh file is read).
+//!   `<option><flag filterparent>` sets the collision filter's parent rule.
 //!
 //! MuJoCo adds no free joint when it compiles a URDF on its own, so the robot is fixed to the
 //! world there. Retargeting needs a free root, so by default ([`UrdfBase::Floating`]) the root
@@ -113,12 +123,14 @@ pub(crate) enum Shape {
     },
 }
 
-/// A `<collision>` (visuals are not kept).
+/// A `<collision>`, or a `<visual>` when `<mujoco><compiler discardvisual="false">` keeps
+/// them (MuJoCo's visual geoms: `contype = conaffinity = 0`).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct CollisionSpec {
     pub name: Option<String>,
     pub origin: Origin,
     pub shape: Shape,
+    pub visual: bool,
 }
 
 /// An `<inertial>`: `<mass value>` and all six `<inertia>` attributes are required, as in
@@ -172,10 +184,17 @@ pub(crate) struct JointSpec {
     pub pos: Pos,
 }
 
-/// `<mujoco><compiler>` inside `<robot>` (MuJoCo's extension), the attributes that matter.
+/// `<mujoco>` inside `<robot>` (MuJoCo's extension): the `<compiler>` attributes and the
+/// `<option>` flag that matter here.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct MujocoSpec {
     pub fusestatic: Option<bool>,
+    /// `discardvisual` (MuJoCo's URDF default: `true`, visuals dropped).
+    pub discardvisual: Option<bool>,
+    pub autolimits: Option<bool>,
+    pub alignfree: Option<bool>,
+    /// `<option><flag filterparent>`.
+    pub filterparent: Option<bool>,
     /// `inertiafromgeom`: `Some(true)` for `true`, `Some(false)` for `false`, `None` for `auto`.
     pub inertiafromgeom: Option<bool>,
     pub boundmass: Option<f64>,
@@ -238,14 +257,18 @@ pub(crate) fn parse(src: &Sources, text: &str) -> Result<Urdf, Error> {
         mujoco: MujocoSpec::default(),
         pos: at(root),
     };
+    // MuJoCo reads the first <mujoco> before any link, wherever it is written.
+    if let Some(mujoco) = child(root, "mujoco") {
+        p.mujoco(mujoco, &mut urdf.mujoco)?;
+    }
+    let keep_visuals = urdf.mujoco.discardvisual == Some(false);
     for el in elements(root) {
         if el.tag_name().namespace().is_some_and(|ns| ns.contains("xacro")) {
             return Err(src.unsupported(at(el), "xacro element: expand the file with xacro first"));
         }
         match el.tag_name().name() {
-            "link" => urdf.links.push(p.link(el)?),
+            "link" => urdf.links.push(p.link(el, keep_visuals)?),
             "joint" => urdf.joints.push(p.joint(el)?),
-            "mujoco" => p.mujoco(el, &mut urdf.mujoco)?,
             // material, transmission, gazebo, ...: no effect on kinematics.
             _ => {}
         }
@@ -346,19 +369,26 @@ impl Parser<'_> {
         Ok(origin)
     }
 
-    fn link(&self, el: Node<'_, '_>) -> Result<LinkSpec, Error> {
+    fn link(&self, el: Node<'_, '_>, keep_visuals: bool) -> Result<LinkSpec, Error> {
         let name = self.required(el, "name")?.value().to_owned();
         let mut inertials = elements(el).filter(|c| c.tag_name().name() == "inertial");
         let inertial = inertials.next().map(|i| self.inertial(i)).transpose()?;
         if let Some(second) = inertials.next() {
             return Err(self.src.invalid(at(second), "repeated <inertial> in a link"));
         }
+        // Visual and collision geoms in the order written (MuJoCo's `mjXURDF::Body`).
         let mut collisions = Vec::new();
-        for c in elements(el).filter(|c| c.tag_name().name() == "collision") {
+        for c in elements(el) {
+            let visual = match c.tag_name().name() {
+                "collision" => false,
+                "visual" if keep_visuals => true,
+                _ => continue,
+            };
             collisions.push(CollisionSpec {
                 name: attribute(c, "name").map(|a| a.value().to_owned()),
                 origin: self.origin(c)?,
                 shape: self.shape(self.required_child(c, "geometry")?)?,
+                visual,
             });
         }
         Ok(LinkSpec { name, inertial, collisions, pos: at(el) })
@@ -479,9 +509,26 @@ impl Parser<'_> {
         })
     }
 
-    /// `<mujoco><compiler .../></mujoco>`: only what changes the kinematic tree or the
-    /// inertials is read.
+    /// `<mujoco>`: MuJoCo reads its `<compiler>` with every MJCF compiler attribute, then
+    /// forces radians; `<option>` and `<size>` as in MJCF. Kept here: what changes the body
+    /// tree, the geoms, the limits or the inertials (and the collision filter); the rest
+    /// (`angle`, `eulerseq`: URDF angles and `rpy` are fixed; `meshdir`, `strippath`: no mesh
+    /// is read; `usethread`, `fitaabb`, ...) is read and has no effect.
     fn mujoco(&self, el: Node<'_, '_>, out: &mut MujocoSpec) -> Result<(), Error> {
+        if let Some(option) = child(el, "option") {
+            if let Some(a) = child(option, "flag").and_then(|f| attribute(f, "filterparent")) {
+                out.filterparent = Some(match a.value() {
+                    "enable" => true,
+                    "disable" => false,
+                    other => {
+                        return Err(self.src.invalid(
+                            attr_at(&a),
+                            format!("attribute filterparent: \"{other}\" is not enable or disable"),
+                        ))
+                    }
+                });
+            }
+        }
         let Some(compiler) = child(el, "compiler") else { return Ok(()) };
         for a in compiler.attributes() {
             let flag = || match a.value() {
@@ -495,28 +542,18 @@ impl Parser<'_> {
             let number = || self.numbers::<1>(&a).map(|[v]| Some(v));
             match a.name() {
                 "fusestatic" => out.fusestatic = Some(flag()?),
+                "discardvisual" => out.discardvisual = Some(flag()?),
+                "autolimits" => out.autolimits = Some(flag()?),
+                "alignfree" => out.alignfree = Some(flag()?),
                 "inertiafromgeom" if a.value() == "auto" => out.inertiafromgeom = None,
                 "inertiafromgeom" => out.inertiafromgeom = Some(flag()?),
                 "boundmass" => out.boundmass = number()?,
                 "boundinertia" => out.boundinertia = number()?,
                 "balanceinertia" => out.balanceinertia = Some(flag()?),
                 "settotalmass" => out.settotalmass = number()?,
-                "discardvisual" if !flag()? => {
-                    return Err(self.src.unsupported(
-                        attr_at(&a),
-                        "discardvisual=\"false\" (visual geoms are not read)",
-                    ))
+                "coordinate" if a.value() == "global" => {
+                    return Err(self.src.invalid(attr_at(&a), crate::syntax::GLOBAL_COORDINATES))
                 }
-                "alignfree" if flag()? => {
-                    return Err(self.src.unsupported(
-                        attr_at(&a),
-                        "alignfree=\"true\" (moves free bodies to their inertial frame)",
-                    ))
-                }
-                "autolimits" if !flag()? => {
-                    return Err(self.src.unsupported(attr_at(&a), "autolimits=\"false\""))
-                }
-                // angle (URDF is always radians), meshdir, inertiagrouprange, ...
                 _ => {}
             }
         }
@@ -744,6 +781,10 @@ struct Builder<'s> {
     /// `inertiafromgeom="auto"`: a link without `<inertial>` weighs what its geoms do
     /// (`"false"`: nothing).
     geoms_weigh: bool,
+    /// `<mujoco><compiler autolimits>`: `false` makes a joint with a range an error.
+    autolimits: bool,
+    /// `<mujoco><compiler alignfree>`.
+    align_free: bool,
     geom_names: HashSet<String>,
     /// Mesh name of each (file name stem, scale) seen, MuJoCo's naming: `stem`, `stem1`, ...
     meshes: Vec<(String, [f64; 3], String)>,
@@ -787,6 +828,8 @@ impl<'s> Builder<'s> {
             body_mass: vec![Mass::Zero],
             inertia: InertiaOptions::default(),
             geoms_weigh: true,
+            autolimits: true,
+            align_free: false,
             geom_names: HashSet::new(),
             meshes: Vec::new(),
         }
@@ -821,6 +864,9 @@ impl<'s> Builder<'s> {
             total_mass: spec.settotalmass.filter(|&m| m > 0.0),
         };
         self.geoms_weigh = spec.inertiafromgeom != Some(false);
+        self.autolimits = spec.autolimits.unwrap_or(true);
+        self.align_free = spec.alignfree.unwrap_or(false);
+        self.model.filter_parent = spec.filterparent.unwrap_or(true);
     }
 
     /// A link's own mass, its `<inertial>` in the link frame as `xml_urdf.cc` reads it (an
@@ -828,7 +874,8 @@ impl<'s> Builder<'s> {
     /// checks it. Every link is checked, also one fused into the world, as MuJoCo does.
     fn link_mass(&self, link: &LinkSpec) -> Result<Mass, Error> {
         let Some(spec) = &link.inertial else {
-            let weighs = self.geoms_weigh && !link.collisions.is_empty();
+            // Visual geoms have density 0 (MuJoCo's URDF import).
+            let weighs = self.geoms_weigh && link.collisions.iter().any(|c| !c.visual);
             return Ok(if weighs { Mass::FromGeoms } else { Mass::Zero });
         };
         let (quat, diag) = if spec.inertia == [0.0; 6] {
@@ -938,6 +985,18 @@ impl<'s> Builder<'s> {
             (Some(lo), Some(hi)) if lo < hi => Some([lo, hi]),
             _ => None,
         };
+        // MuJoCo leaves such a joint `limited="auto"`, which autolimits="false" refuses.
+        let auto = matches!((limit.lower, limit.upper), (Some(lo), Some(hi)) if lo <= hi);
+        let nonzero = limit.lower.unwrap_or(0.0) != 0.0 || limit.upper.unwrap_or(0.0) != 0.0;
+        if !self.autolimits && auto && nonzero && spec.kind != UrdfJointType::Fixed {
+            return Err(self.src.invalid(
+                spec.pos,
+                format!(
+                    "joint \"{}\" has a range but no limited attribute and autolimits is false (MuJoCo refuses it)",
+                    spec.name
+                ),
+            ));
+        }
         let name = spec.name.clone();
         let first = match spec.kind {
             UrdfJointType::Fixed => return Ok(()),
@@ -1016,9 +1075,9 @@ impl<'s> Builder<'s> {
             pos: placed.pos,
             quat: placed.quat,
             mesh,
-            // MuJoCo's defaults: URDF has no collision filter of its own.
-            contype: 1,
-            conaffinity: 1,
+            // MuJoCo's defaults: URDF has no collision filter of its own; visuals never collide.
+            contype: i32::from(!spec.visual),
+            conaffinity: i32::from(!spec.visual),
         });
     }
 
@@ -1054,6 +1113,15 @@ impl<'s> Builder<'s> {
             inertia::set_total_mass(&mut m.bodies, total);
         }
         m.geoms = self.body_geoms.drain(..).flatten().collect();
+        if self.align_free {
+            let free: Vec<usize> =
+                m.joints.iter().filter(|j| j.kind == JointType::Free).map(|j| j.body).collect();
+            for b in free {
+                if !m.bodies.iter().any(|c| c.parent == b) {
+                    m.align_to_inertia(b);
+                }
+            }
+        }
         m.jnt_pos_zero = vec![true; m.joints.len()];
         m.geom_mat = m.geoms.iter().map(|g| *g.quat.to_rotation_matrix().matrix()).collect();
         m
@@ -1243,5 +1311,55 @@ mod tests {
             let m = Model::from_urdf_str(&urdf(limit), options).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!((m.joints[0].range, m.joints[0].velocity_limit), (range, speed), "{limit}");
         }
+    }
+
+    /// `<mujoco><compiler discardvisual="false">`: visuals become geoms that never collide,
+    /// in the order written among the collisions; every other compiler attribute MuJoCo reads
+    /// is accepted, `<option><flag filterparent>` applies.
+    #[test]
+    fn mujoco_block_keeps_visuals_and_reads_every_compiler_attribute() {
+        let urdf = |compiler: &str| {
+            format!(
+                r#"<robot name="r"><mujoco><compiler {compiler}/><option><flag filterparent="disable"/></option>
+                   <size njmax="100"/></mujoco>
+                   {}{}{}
+                   <joint name="j" type="revolute"><origin rpy="0.5 0 0"/><parent link="a"/><child link="b"/>
+                     <limit lower="-1" upper="1"/></joint>
+                   <joint name="k" type="fixed"><origin xyz="0 0 0.3"/><parent link="b"/><child link="c"/></joint></robot>"#,
+                inertial_link("a", "0 0 0", "0 0 0", 1.0, [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]).replace(
+                    "</link>",
+                    r#"<visual name="v1"><geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+                       <collision name="c1"><origin xyz="0 0 0.1"/><geometry><sphere radius="0.1"/></geometry></collision>
+                       <visual><origin xyz="0.2 0 0"/><geometry><sphere radius="0.2"/></geometry></visual></link>"#
+                ),
+                inertial_link("b", "0 0 0", "0 0 0", 1.0, [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]),
+                r#"<link name="c"><visual><geometry><cylinder radius="0.1" length="0.2"/></geometry></visual></link>"#,
+            )
+        };
+        let kept = urdf(
+            r#"discardvisual="false" coordinate="local" angle="degree" eulerseq="zyx" strippath="true" meshdir="x" usethread="false""#,
+        );
+        let m = Model::from_urdf_str(&kept, FIXED).unwrap_or_else(|e| panic!("{e}"));
+        let geoms: Vec<_> =
+            m.geoms.iter().map(|g| (g.name.as_str(), g.body, g.kind, g.contype)).collect();
+        assert_eq!(
+            geoms,
+            [
+                ("v1", 0, GeomType::Box, 0),
+                ("c1", 0, GeomType::Sphere, 1),
+                ("", 0, GeomType::Sphere, 0),
+                ("", 1, GeomType::Cylinder, 0)
+            ]
+        );
+        assert!(!m.filter_parent);
+        // Radians whatever `angle` says: the joint origin turns 0.5 rad.
+        assert!((m.bodies[1].quat.angle() - 0.5).abs() < 1e-15);
+        matches_mujoco(&m, &kept, FIXED, 1);
+        let dropped = Model::from_urdf_str(&urdf(""), FIXED).unwrap();
+        assert_eq!(dropped.geoms.len(), 1);
+        matches_mujoco(&dropped, &urdf(""), FIXED, 1);
+        // autolimits="false": a joint with a range is refused, as MuJoCo refuses it.
+        let err = Model::from_urdf_str(&urdf(r#"autolimits="false""#), FIXED).unwrap_err();
+        assert!(err.to_string().contains("autolimits is false"), "{err}");
     }
 }

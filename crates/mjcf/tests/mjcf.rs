@@ -318,7 +318,7 @@ fn errors_name_file_line_and_column() {
         ("<mujoco><worldbody>\n<body><composite/></body></worldbody></mujoco>",
          "<string>:2:7: unsupported: element <composite> in a body"),
         ("<mujoco><worldbody>\n<body><body><freejoint/></body></body></worldbody></mujoco>",
-         "<string>:2:13: unsupported: a free joint in a body that is not a child of the world"),
+         "<string>:2:13: free joint can only be used on top level"),
         ("<mujoco><compiler autolimits=\"false\"/><worldbody>\n<body><joint range=\"0 1\"/></body></worldbody></mujoco>",
          "<string>:2:7: joint has a range but no limited attribute and autolimits is false; set limited or autolimits"),
         ("<mujoco><worldbody>\n<body quat=\"1 0 0 0\" euler=\"0 0 0\"/></worldbody></mujoco>",

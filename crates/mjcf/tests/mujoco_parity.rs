@@ -108,6 +108,104 @@ fn repo_models_match_mujoco() {
 }
 
 // ------------------------------------------------------------------------------------------
+// The corpus: every robot model file of the repository's test data and of the shared
+// reference robots, read by us and compiled by MuJoCo. Both must load it or both refuse it;
+// when both load it, the compiled models must agree (sizes, names, order, frames, ranges,
+// `qpos0`, inertials) and so must every body pose and Jacobian at `qpos0` and 100 random
+// configurations.
+
+/// Every `.xml` and `.urdf` below `dir`, sorted (an absent folder holds none).
+fn model_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut paths: Vec<PathBuf> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+    paths.sort();
+    for path in paths {
+        if path.is_dir() {
+            model_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "xml" || e == "urdf") {
+            out.push(path);
+        }
+    }
+}
+
+/// The corpus: `tests/data` and every crate's `tests/data` in the repository, the shipped
+/// `robots/`, and (when given) the shared reference robots.
+fn corpus(shared: Option<&Path>) -> Vec<PathBuf> {
+    let root = repo_root();
+    let mut files = Vec::new();
+    model_files(&root.join("tests/data"), &mut files);
+    model_files(&root.join("robots"), &mut files);
+    let crates = std::fs::read_dir(root.join("crates")).expect("crates/ is readable");
+    let mut crates: Vec<PathBuf> = crates.filter_map(Result::ok).map(|e| e.path()).collect();
+    crates.sort();
+    for krate in crates {
+        model_files(&krate.join("tests/data"), &mut files);
+    }
+    if let Some(shared) = shared {
+        model_files(&shared.join("reference/robots"), &mut files);
+    }
+    files
+}
+
+/// One corpus file: `Ok(line)` when we and MuJoCo agree (both load it and match, or both
+/// refuse it), `Err(why)` otherwise.
+fn corpus_entry(path: &Path) -> Result<String, String> {
+    let ours = Model::from_path(path);
+    let theirs = match &ours {
+        Ok(model) => check_file(model, path, CheckOptions::default()),
+        // MuJoCo's verdict alone: compared with a model of nothing, it only has to load.
+        Err(_) => check_file(
+            &Model::from_xml_str("<mujoco/>", None).expect("empty model"),
+            path,
+            CheckOptions { configs: 0, seed: 1 },
+        ),
+    };
+    match (ours, theirs) {
+        (Ok(model), Ok(report)) if report.passes(TOLERANCE) => Ok(format!(
+            "loads, nq {} nbody {} njnt {}, max deviation {:.1e} ({} inertials compared)",
+            model.nq,
+            model.bodies.len(),
+            model.joints.len(),
+            report.max_deviation(),
+            report.inertials
+        )),
+        (Ok(_), Ok(report)) => Err(format!("differs from mujoco\n{report}")),
+        (Err(e), Err(m)) => Ok(format!("refused by both: ours \"{e}\"; mujoco \"{m}\"")),
+        (Ok(_), Err(m)) => Err(format!("loads here, mujoco refuses it: {m}")),
+        (Err(e), Ok(_)) => Err(format!("mujoco loads it, we refuse it: {e}")),
+    }
+}
+
+#[test]
+fn corpus_agrees_with_mujoco() {
+    let shared = shared::shared_dir();
+    let files = corpus(shared.as_deref());
+    let expected = if shared.is_some() { 30 } else { 10 };
+    assert!(files.len() >= expected, "the corpus holds {} files", files.len());
+    let root = repo_root();
+    let mut failures = Vec::new();
+    for path in &files {
+        let label = path
+            .strip_prefix(&root)
+            .or_else(|_| {
+                shared.as_deref().map_or(Err(()), |s| path.strip_prefix(s).map_err(|_| ()))
+            })
+            .map_or_else(|_| path.display().to_string(), |p| p.display().to_string());
+        match corpus_entry(path) {
+            Ok(line) => eprintln!("{label}: {line}"),
+            Err(why) => failures.push(format!("{label}: {why}")),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} files:\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
+}
+
+// ------------------------------------------------------------------------------------------
 // URDF: our reading against MuJoCo's own URDF import (see `mujoco_check`): the robot fixed to
 // the world as MuJoCo compiles it, and with the free root we add (added on MuJoCo's side
 // through its model-editing API); static links fused (MuJoCo's URDF default) and kept.

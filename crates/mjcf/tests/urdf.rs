@@ -321,8 +321,10 @@ fn errors_name_file_line_and_column() {
         ("<robot name=\"r\">\n<link name=\"a\"></robot>".to_owned(), "<string>:2:16: invalid xml: expected 'link' tag, not 'robot'"),
         ("<mujoco/>".to_owned(), "<string>:1:1: root element is <mujoco>, expected <robot>"),
         ("<robot name=\"r\"/>".to_owned(), "<string>:1:1: <robot> has no <link>"),
-        (robot("<mujoco><compiler discardvisual=\"false\"/></mujoco>"),
-         "<string>:2:19: unsupported: discardvisual=\"false\" (visual geoms are not read)"),
+        (robot("<mujoco><compiler coordinate=\"global\"/></mujoco>"),
+         "<string>:2:19: global coordinates no longer supported. To convert existing models, load and save them in MuJoCo 2.3.3 or older"),
+        (robot("<mujoco><compiler discardvisual=\"no\"/></mujoco>"),
+         "<string>:2:19: attribute discardvisual: \"no\" is not true or false"),
         (robot(&format!("{}{}", link("world"), joint("j", "fixed", "a", "world"))),
          "<string>:2:1: a link called \"world\" must be the root link"),
         // <inertial>: MuJoCo's required elements and attributes, and its checks.
@@ -371,4 +373,21 @@ fn errors_name_file_line_and_column() {
         .unwrap_err()
         .to_string()
         .starts_with("/nonexistent/robot.urdf: cannot read file"));
+}
+
+/// A floating base added to the fixed robot is the free root the URDF reader adds itself.
+#[test]
+fn floating_base_added_later_is_the_urdf_free_root() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/urdf/features.urdf");
+    // Unfused: fixed to the world, the root link would be fused into it.
+    let fixed = UrdfOptions { base: UrdfBase::Fixed, fuse_static: Some(false) };
+    let mut m = Model::from_urdf_file(&path, fixed).unwrap();
+    let floating =
+        Model::from_urdf_file(&path, UrdfOptions { base: UrdfBase::Floating, ..fixed }).unwrap();
+    let root = m.root_body().unwrap();
+    let (pos, quat) = (m.bodies[root].pos, m.bodies[root].quat);
+    let base = m.add_floating_base(pos, quat).unwrap();
+    assert_eq!(base.joint, floating.joints[0].name);
+    assert_eq!(m, floating);
+    assert_eq!(m.clone().add_floating_base(pos, quat), None, "a second one is not added");
 }

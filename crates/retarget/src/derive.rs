@@ -107,6 +107,10 @@ pub const WEIGHTS: [(Part, [f64; 4]); 8] = [
 /// A foot counts as flat on the floor while its ankle is within this of its flat height (m).
 const FLAT_FOOT: f64 = 0.03;
 
+/// A knee or elbow range whose two sides from straight differ by less than this share of it
+/// is symmetric (servos'): it does not tell the flexion sense.
+const SYMMETRIC_RANGE: f64 = 0.1;
+
 /// Frames of a motion sampled, evenly, for the proportions and the offset fits.
 const POSTURES: usize = 256;
 
@@ -669,7 +673,10 @@ fn middle_hinge(
 /// elbow with the arm hanging), the thigh and shin so that the knee flexes about +y
 /// (backward). A robot elbow that bends sideways at `qpos0` (ToddlerBot's) is then matched
 /// with the human's flexion, not its abduction. The flexion sense is the larger side of the
-/// range from straight. Also the knee and elbow hinges in the new frames.
+/// range from straight; for a symmetric range (servos', within 10 %), backward for the knee and
+/// forward for the elbow as the robot faces (ROBOTIS OP3's right knee, whose axis is the
+/// left's mirrored, was read as bending forward). Also the knee and elbow hinges in the new
+/// frames.
 fn limb_frames(
     model: &Model,
     data: &Data,
@@ -691,7 +698,23 @@ fn limb_frames(
             let Some((axis, straight, [lo, hi])) = middle_hinge(model, data, roles, limb) else {
                 continue;
             };
-            let flexion = if hi - straight >= straight - lo { axis } else { -axis };
+            // A servo's symmetric range does not say which way the joint bends: then the
+            // knee bends backward and the elbow forward (their frames' y is the robot's left).
+            let larger = (hi - straight) - (straight - lo);
+            let flexion = if larger.abs() > SYMMETRIC_RANGE * (hi - lo) {
+                if larger > 0.0 {
+                    axis
+                } else {
+                    -axis
+                }
+            } else {
+                let left = Vector3::z().cross(&roles.forward);
+                if (axis * y_sign).dot(&left) >= 0.0 {
+                    axis
+                } else {
+                    -axis
+                }
+            };
             for &part in twisted {
                 let role = Role::of(part, side);
                 let Some(c) = frames.get(&role) else { continue };
@@ -1046,6 +1069,8 @@ struct Row {
     rot: UnitQuaternion<f64>,
     pos: Vector3<f64>,
     scale: f64,
+    /// `[table1 pos, table1 rot, table2 pos, table2 rot]`.
+    weights: [f64; 4],
 }
 
 /// The config that maps `human` onto the robot (see the module docs); `source` names it in
@@ -1085,9 +1110,17 @@ pub fn derive(
         let origin = robot.origins.get(&role).copied().unwrap_or_default();
         let pos = fitted_offset(&robot, human, role, origin, *relative, root_scale, scale)
             .unwrap_or(*offset);
-        rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale });
+        let mut weights = weights(role.part(), robot.bodies.contains_key(&Role::Chest));
+        if role.part() == Part::UpperArm && shoulder_hinges(model, roles, role) < 3 {
+            // A shoulder of two hinges (servo humanoids') cannot take the upper arm's twist:
+            // weighed as GMR weighs it, the part it cannot follow turned the shoulder into
+            // another branch and pulled the trunk round (a 0.45 m servo robot on the LAFAN1
+            // walk: hands L↔L 0.43 → 0.64, legs' likeness 0.81 → 0.64).
+            weights[1] = weights_of(Part::Forearm)[1];
+        }
+        rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale, weights });
     }
-    let text = config_json(&rows, human.height, robot.bodies.contains_key(&Role::Chest));
+    let text = config_json(&rows, human.height);
     IkConfig::from_json_str(&text, source)
 }
 
@@ -1157,7 +1190,16 @@ pub fn bind(
         };
         rows.push((
             e.clone(),
-            Row { role, body: e.robot_body.clone(), joint: joint.clone(), rot, pos, scale },
+            // The file's weights are kept (below): the row's are not used.
+            Row {
+                role,
+                body: e.robot_body.clone(),
+                joint: joint.clone(),
+                rot,
+                pos,
+                scale,
+                weights: [0.0; 4],
+            },
         ));
     }
     let height = human.height * config.human_height_assumption / canonical.height;
@@ -1215,8 +1257,35 @@ pub fn is_role_named(config: &IkConfig) -> bool {
 /// pelvis body: no waist) tracks its pelvis with the larger of the pelvis's and the chest's
 /// weights: that body is its chest too, and with the pelvis's rotation weight (10) against
 /// the upper arms' (100) arms that cannot reach their targets tilt the whole robot.
+fn weights_of(part: Part) -> [f64; 4] {
+    WEIGHTS.iter().find(|(q, _)| *q == part).map_or([0.0; 4], |w| w.1)
+}
+
+/// Hinges from the chest (else the pelvis) down to the upper arm's body (`role`), included.
+fn shoulder_hinges(model: &Model, roles: &RobotRoles, role: Role) -> usize {
+    let (Some(arm), Some(top)) =
+        (roles.body(role), roles.body(Role::Chest).or(roles.body(Role::Pelvis)))
+    else {
+        return 0;
+    };
+    let mut count = 0;
+    let mut b = arm;
+    while b != top && b != 0 {
+        let Some(body) = model.bodies.get(b) else { break };
+        count += model
+            .joints
+            .iter()
+            .skip(body.jnt_adr)
+            .take(body.jnt_num)
+            .filter(|j| j.kind == mjcf::JointType::Hinge)
+            .count();
+        b = body.parent;
+    }
+    count
+}
+
 fn weights(part: Part, robot_has_chest: bool) -> [f64; 4] {
-    let of = |p: Part| WEIGHTS.iter().find(|(q, _)| *q == p).map_or([0.0; 4], |w| w.1);
+    let of = weights_of;
     let own = of(part);
     if part != Part::Pelvis || robot_has_chest {
         return own;
@@ -1229,7 +1298,7 @@ fn weights(part: Part, robot_has_chest: bool) -> [f64; 4] {
     out
 }
 
-fn config_json(rows: &[Row], height: f64, robot_has_chest: bool) -> String {
+fn config_json(rows: &[Row], height: f64) -> String {
     let joints: BTreeMap<Role, String> = rows.iter().map(|r| (r.role, r.joint.clone())).collect();
     let mut text = String::new();
     let pelvis = rows.iter().find(|r| r.role == Role::Pelvis);
@@ -1250,8 +1319,7 @@ fn config_json(rows: &[Row], height: f64, robot_has_chest: bool) -> String {
         let entries: Vec<TableRow> = rows
             .iter()
             .map(|r| {
-                let w = weights(r.role.part(), robot_has_chest);
-                let weight = |k: usize| w.get(k).copied().unwrap_or(0.0);
+                let weight = |k: usize| r.weights.get(k).copied().unwrap_or(0.0);
                 (r.body.clone(), r.joint.clone(), weight(*table), weight(table + 1), r.pos, r.rot)
             })
             .collect();

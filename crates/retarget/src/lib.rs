@@ -76,6 +76,7 @@ pub mod derive;
 mod error;
 pub mod fbx_clip;
 pub mod feet;
+pub mod follow;
 pub mod gmr;
 pub mod joint_speed;
 pub mod lie;

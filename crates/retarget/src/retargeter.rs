@@ -117,19 +117,22 @@ pub struct Retargeter {
     options: RetargetOptions,
     stream_fps: f64,
     stream: Mutex<Option<Stream>>,
+    /// What was done to the robot's model file to retarget onto it.
+    notes: Vec<String>,
 }
 
 impl Retargeter {
     /// A shipped robot by key (`unitree_g1`, see [`shipped::keys`]) with its tuned config, or
     /// an MJCF (`.xml`) or URDF (`.urdf`) file ([`shipped::load_robot`]); the default options.
     pub fn new(robot: &str) -> Result<Retargeter, Error> {
-        let model = shipped::load_robot(robot)?;
+        let (model, notes) = shipped::load_robot_noted(robot)?;
         let tuned = match shipped::find(robot) {
             Some(r) => Some(r.config()?),
             None => None,
         };
         let mut retargeter = Retargeter::from_model(model, &shipped::robot_label(robot));
         retargeter.tuned = tuned;
+        retargeter.notes = notes;
         Ok(retargeter)
     }
 
@@ -144,9 +147,10 @@ impl Retargeter {
     /// A robot model file and an IK config file (GMR schema).
     pub fn from_files(robot: &Path, config: &Path) -> Result<Retargeter, Error> {
         let robot = robot.to_string_lossy();
-        let model = shipped::load_robot(&robot)?;
-        Ok(Retargeter::from_model(model, &shipped::robot_label(&robot))
-            .with_config(IkConfig::from_file(config)?))
+        let (model, notes) = shipped::load_robot_noted(&robot)?;
+        let mut retargeter = Retargeter::from_model(model, &shipped::robot_label(&robot));
+        retargeter.notes = notes;
+        Ok(retargeter.with_config(IkConfig::from_file(config)?))
     }
 
     /// Any compiled model; `label` names the robot in messages and derived configs.
@@ -160,7 +164,15 @@ impl Retargeter {
             options: RetargetOptions::default(),
             stream_fps: 30.0,
             stream: Mutex::new(None),
+            notes: Vec::new(),
         }
+    }
+
+    /// What was done to the robot's model file to retarget onto it (a floating base added
+    /// to a model without one), one sentence each; empty for shipped robots.
+    #[must_use]
+    pub fn robot_notes(&self) -> &[String] {
+        &self.notes
     }
 
     /// Use `config` for every clip and frame (bound to each skeleton when role-named).

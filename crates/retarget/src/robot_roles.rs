@@ -5,12 +5,15 @@
 //!
 //! The rules, in the order they run (each role's [`RobotRole::rule`] says which decided it):
 //!
+//! 0. A model without a free joint gets one first ([`add_floating_base`], called by
+//!    [`crate::shipped::load_robot`]), stood up when it lies at `qpos0`.
 //! 1. **Floating base**: the body of the first free joint (a URDF gets one on loading).
 //! 2. **Legs**: the lowest body at `qpos0` (origin or primitive geom) is one foot; walking up
 //!    its ancestors, the first one with another branch that reaches as low (within 15 % of the
 //!    robot's height) while hanging at least 25 % of that height below it is the **pelvis**;
-//!    the lowest body of that branch is the other foot. A branch ending in an unlimited hinge
-//!    is a wheel, not a foot.
+//!    the lowest body of that branch is the other foot. A leg rolling on a wheel (an unlimited
+//!    hinge across the direction of travel carrying a round geom on the floor) is an error;
+//!    an unlimited hinge alone is only a joint without limits (ROBOTIS OP3's ankles).
 //! 3. **Arms**: among the bodies outside the legs, the ones farthest to either side of the
 //!    hips' left-right axis belong to the two arms; their lowest common ancestor is the
 //!    **chest**, and each arm runs from it to the body of its branch farthest from the chest
@@ -68,6 +71,9 @@ const PERPENDICULAR_COS: f64 = 0.5;
 const LEG_LENGTH: f64 = 0.25;
 /// ... and the second foot is within this share of the height of the lowest point.
 const FEET_LEVEL: f64 = 0.15;
+/// A wheel's axis is within 30° of the hips' left-right axis (|cos| above this), and so is a
+/// round geom's own axis to the wheel's.
+const WHEEL_AXIS_COS: f64 = 0.866;
 
 /// The body playing a role, the point the human joint maps to, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -211,6 +217,89 @@ impl RobotRoles {
             );
         }
         out
+    }
+}
+
+/// Turns that may stand a lying model up, tried in this order (identity first): the file's
+/// up axis → +z.
+const STAND_UP: [(&str, [f64; 3], f64); 6] = [
+    ("", [1.0, 0.0, 0.0], 0.0),
+    ("+y", [1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2),
+    ("-y", [1.0, 0.0, 0.0], -std::f64::consts::FRAC_PI_2),
+    ("+x", [0.0, 1.0, 0.0], -std::f64::consts::FRAC_PI_2),
+    ("-x", [0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2),
+    ("-z", [1.0, 0.0, 0.0], std::f64::consts::PI),
+];
+
+/// Rule 0, before the others: a model without a free joint (an MJCF whose floating base the
+/// user's code adds, dm_control style) gets one on its root body ([`Model::root_body`]), the
+/// way a URDF gets one on loading. When the file stands along another axis than +z (dm_control's
+/// CMU humanoid is Y up), the base's rest pose turns it upright and puts its lowest point on
+/// the floor: of the six axis-aligned ups, the first under which [`RobotRoles::recognise`]
+/// finds a humanoid standing (+z first). Returns what was done, for the output to say once;
+/// `None` when the model had a free joint (or has no jointless root body to put one on).
+pub fn add_floating_base(model: &mut Model) -> Option<String> {
+    if model.has_free_joint() {
+        return None;
+    }
+    let root = model.root_body()?;
+    let body = model.bodies.get(root)?;
+    let (pos, quat) = (body.pos, body.quat);
+    let mut first = None;
+    for (up, axis, angle) in STAND_UP {
+        let turn =
+            UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(axis.into()), angle);
+        let mut candidate = model.clone();
+        let base = candidate.add_floating_base(turn * pos, turn * quat)?;
+        if !up.is_empty() {
+            lift_to_floor(&mut candidate, base.body);
+        }
+        let recognised = RobotRoles::recognise(&candidate).is_ok();
+        let stood = if up.is_empty() {
+            String::new()
+        } else {
+            format!(", turned so that the file's {up} is up (the model lies at qpos0)")
+        };
+        let note = format!(
+            "`{}` has no free joint: a floating base `{}` was added at body `{}` for \
+             retargeting{stood}",
+            model.name,
+            base.joint,
+            body_name(model, base.body)
+        );
+        if recognised {
+            *model = candidate;
+            return Some(note);
+        }
+        first.get_or_insert((candidate, note));
+    }
+    let (candidate, note) = first?;
+    *model = candidate;
+    Some(note)
+}
+
+/// Moves the free body `body` up or down so that the model's lowest point (geoms, else body
+/// origins) is at z = 0 at `qpos0`.
+fn lift_to_floor(model: &mut Model, body: usize) {
+    let mut data = Data::new(model);
+    model.kinematics(&model.qpos0, &mut data);
+    let mut low = f64::INFINITY;
+    for g in (0..model.geoms.len()).filter(|&g| model.geoms[g].body != 0) {
+        if let Some(p) = mjcf::geom_lowest_point(model, &data, g) {
+            low = low.min(p.z);
+        }
+    }
+    if !low.is_finite() {
+        low = data.xpos.iter().skip(1).map(|p| p.z).fold(f64::INFINITY, f64::min);
+    }
+    let Some(joint) = model.joints.iter().find(|j| j.body == body && j.kind == JointType::Free)
+    else {
+        return;
+    };
+    let adr = joint.qpos_adr + 2;
+    if let (true, Some(z)) = (low.is_finite(), model.qpos0.get_mut(adr)) {
+        *z -= low;
+        model.bodies[body].pos.z -= low;
     }
 }
 
@@ -406,21 +495,23 @@ impl<'m> Recogniser<'m> {
             .iter()
             .map(|&f| self.limb(self.path(pelvis, f), "leg", "knee"))
             .collect::<Result<Vec<Limb>, Error>>()?;
-        for (leg, &foot) in legs.iter().zip(&feet) {
-            if let Some(wheel) = leg.distal.last().filter(|h| h.range.is_none()) {
-                return Err(self.not_humanoid(format!(
-                    "wheeled: the leg ending in `{}` has an unlimited (continuous) hinge on `{}`",
-                    self.name(foot),
-                    self.name(wheel.body)
-                )));
-            }
-        }
         let hips = [legs[0].root(), legs[1].root()];
         let mut across = hips[0] - hips[1];
         across.z = 0.0;
         let across = across
             .try_normalize(1e-9)
             .ok_or_else(|| self.not_humanoid("the two legs start at the same point".to_owned()))?;
+        for (leg, &foot) in legs.iter().zip(&feet) {
+            if let Some(wheel) = leg.distal.iter().rev().find(|h| self.is_wheel(h, across)) {
+                return Err(self.not_humanoid(format!(
+                    "wheeled: the leg ending in `{}` rolls on a wheel: an unlimited (continuous) \
+                     hinge on `{}` across the direction of travel, carrying a round geom on the \
+                     floor",
+                    self.name(foot),
+                    self.name(wheel.body)
+                )));
+            }
+        }
         let (chest, hands) = self.arms(pelvis, &feet, across, (hips[0] + hips[1]) / 2.0)?;
         let arms = hands
             .iter()
@@ -454,6 +545,22 @@ impl<'m> Recogniser<'m> {
                     )
                 }
             },
+        };
+        let (left_first, _) = self.sides(&legs, &arms, forward);
+        // Names that put both limbs on the other side than the geometry's facing says turn the
+        // facing round (the names decide the sides, and the facing follows them): feet whose
+        // body origins sit behind the ankle (ROBOTIS OP3's) vote the wrong way.
+        let left = Vector3::z().cross(&forward);
+        let by_geometry = (legs[0].root() - legs[1].root()).dot(&left) > 0.0;
+        let arms_by_geometry = (arms[0].root() - arms[1].root()).dot(&left) > 0.0;
+        let (forward, facing) = if self.named_left_first(&legs, &arms).is_some()
+            && by_geometry != left_first
+            && arms_by_geometry != left_first
+        {
+            let f = -forward;
+            (f, format!("({:+.2}, {:+.2}, 0): from the sides' names (the knees and feet voted {facing})", f.x, f.y))
+        } else {
+            (forward, facing)
         };
         let (left_first, sides) = self.sides(&legs, &arms, forward);
         let order = |pair: [Limb; 2]| {
@@ -657,6 +764,33 @@ impl<'m> Recogniser<'m> {
             distal,
             end_body,
             end_point,
+        })
+    }
+
+    /// Rule 2's wheel: an unlimited hinge whose axis is horizontal and across the direction
+    /// of travel (within 30° of the hips' left-right axis), carrying a round geom (a sphere,
+    /// or a cylinder, capsule or ellipsoid turning about its own axis) whose lowest point is
+    /// on the floor (within 2 % of the robot's height of the lowest point). An unlimited
+    /// ankle roll (ROBOTIS OP3's) is a joint without limits, not a wheel.
+    fn is_wheel(&self, hinge: &Hinge, across: Vector3<f64>) -> bool {
+        let floor = self.lowest.iter().copied().fold(f64::INFINITY, f64::min);
+        if hinge.range.is_some() || hinge.axis.dot(&across).abs() < WHEEL_AXIS_COS {
+            return false;
+        }
+        let bodies = self.subtree(hinge.body);
+        self.model.geoms.iter().enumerate().any(|(g, geom)| {
+            let round = match geom.kind {
+                mjcf::GeomType::Sphere => true,
+                mjcf::GeomType::Cylinder | mjcf::GeomType::Capsule | mjcf::GeomType::Ellipsoid => {
+                    let own_axis = self.data.geom_xmat[g].column(2).into_owned();
+                    own_axis.dot(&hinge.axis).abs() > WHEEL_AXIS_COS
+                }
+                _ => false,
+            };
+            round
+                && bodies.contains(&geom.body)
+                && mjcf::geom_lowest_point(self.model, &self.data, g)
+                    .is_some_and(|p| p.z - floor <= 0.02 * self.height)
         })
     }
 

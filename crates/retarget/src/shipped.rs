@@ -98,15 +98,26 @@ pub fn tuned_config(key: &str) -> Option<Result<IkConfig, Error>> {
 /// Joint speed limits come from the robot's `joint_speed_limits.json`
 /// ([`crate::joint_speed`]): the shipped one, or one beside a model file when present (a
 /// URDF's own `velocity` limits are kept unless the file lists the joint).
+///
+/// A model without a free joint gets a floating base
+/// ([`crate::robot_roles::add_floating_base`]); [`load_robot_noted`] says so.
 pub fn load_robot(name_or_path: &str) -> Result<Model, Error> {
+    load_robot_noted(name_or_path).map(|(model, _)| model)
+}
+
+/// [`load_robot`], with what was done to the file's model to retarget onto it (a floating
+/// base added), one sentence each, for the output to say once.
+pub fn load_robot_noted(name_or_path: &str) -> Result<(Model, Vec<String>), Error> {
     if let Some(robot) = find(name_or_path) {
-        return robot.model();
+        return Ok((robot.model()?, Vec::new()));
     }
     if !looks_like_path(name_or_path) {
         return Err(unknown_robot(name_or_path));
     }
     let path = Path::new(name_or_path);
     let mut model = Model::from_path(path)?;
+    let notes: Vec<String> =
+        crate::robot_roles::add_floating_base(&mut model).into_iter().collect();
     let speeds = path.with_file_name("joint_speed_limits.json");
     if speeds.is_file() {
         let origin = speeds.display().to_string();
@@ -114,7 +125,7 @@ pub fn load_robot(name_or_path: &str) -> Result<Model, Error> {
             .map_err(|source| Error::Io { path: origin.clone(), source })?;
         JointSpeedLimits::from_json_str(&text, &origin)?.apply(&mut model, &origin)?;
     }
-    Ok(model)
+    Ok((model, notes))
 }
 
 /// [`Error::UnknownRobot`] for `name`: the shipped robots, and the nearest one by name when

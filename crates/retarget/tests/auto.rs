@@ -427,3 +427,80 @@ fn small_robots_we_write_retarget_or_say_why_not() {
         assert!(err.contains("not a two-armed biped") && err.contains(says), "{name}: {err}");
     }
 }
+
+/// Every robot of `tests/data/robots` (issue 34's classes: public models and ours), loaded as
+/// the CLI loads a file, walks the LAFAN1 walk as the reference robots do.
+#[test]
+fn every_class_of_test_robot_walks_the_lafan1_walk() {
+    let Some(bvh) = lafan_walk() else { return };
+    let mut models: Vec<PathBuf> = Vec::new();
+    for dir in std::fs::read_dir(root().join("tests/data/robots")).unwrap() {
+        let dir = dir.unwrap().path();
+        if dir.is_dir() {
+            for f in std::fs::read_dir(&dir).unwrap() {
+                let f = f.unwrap().path();
+                if f.extension().is_some_and(|e| e == "xml" || e == "urdf") {
+                    models.push(f);
+                }
+            }
+        }
+    }
+    models.sort();
+    assert!(models.len() >= 12, "{models:?}");
+    for path in models {
+        let name =
+            path.strip_prefix(root().join("tests/data/robots")).unwrap().display().to_string();
+        let (model, notes) = retarget::shipped::load_robot_noted(&path.to_string_lossy()).unwrap();
+        let fixed = mjcf::Model::from_path(&path).unwrap();
+        // A floating base is added exactly when the file has none, and said once.
+        assert_eq!(notes.len(), usize::from(!fixed.has_free_joint()), "{name}: {notes:?}");
+        let checks = run(&model, &name, &bvh, None);
+        assert_sane(&name, &checks, true);
+    }
+}
+
+/// Rule 0 and rule 2 on the classes that were refused: dm_control's CMU walker (no free joint,
+/// Y up) is stood up on a floating base; ROBOTIS OP3's unlimited ankle rolls are no wheels, its
+/// facing follows the sides' names where its feet voted backwards.
+#[test]
+fn fixed_base_and_unlimited_hinges_are_humanoids() {
+    let cmu = root().join("tests/data/robots/dm_control_cmu_humanoid/humanoid_CMU_V2020.xml");
+    let (model, notes) = retarget::shipped::load_robot_noted(&cmu.to_string_lossy()).unwrap();
+    assert!(notes[0].contains("root_free_joint") && notes[0].contains("+y is up"), "{notes:?}");
+    let roles = RobotRoles::recognise(&model).unwrap();
+    assert!(roles.height > 1.3 && roles.soles[0].lowest.z.abs() < 0.03, "{}", roles.height);
+    let op3 = small("robotis_op3/op3.xml");
+    let roles = RobotRoles::recognise(&op3).unwrap();
+    assert!((roles.forward - Vector3::x()).norm() < 1e-9, "{}", roles.facing);
+    assert_eq!(op3.joints.iter().filter(|j| j.range.is_none()).count(), 21);
+}
+
+fn small(name: &str) -> mjcf::Model {
+    retarget::shipped::load_robot(&root().join("tests/data/robots").join(name).to_string_lossy())
+        .unwrap()
+}
+
+/// The MocapBank take sits on a chair: the G1's left hip pitch stops at −90°, so its left leg
+/// cannot follow the human there, and the tool says so (`retarget::follow`); the LAFAN1 walk's
+/// start is walked without such a stretch.
+#[test]
+fn a_limb_held_at_its_joint_limits_is_said_not_to_follow() {
+    let Some(path) = shared::shared_file("data/bvh/bvhtoolbox_test_mocapbank.bvh") else { return };
+    let model = shipped_model("unitree_g1");
+    let roles = RobotRoles::recognise(&model).unwrap();
+    let solve = |bvh: &bvh::Bvh| {
+        let chosen =
+            derive::choose(&model, "unitree_g1", bvh, &fk::FkOptions::default(), None, None, false)
+                .unwrap();
+        retarget::retarget_bvh(bvh, &model, &chosen.config, &RetargetOptions::default()).unwrap().0
+    };
+    let motion = solve(&bvh::from_path(&path).unwrap());
+    let blocked = retarget::follow::blocked_limbs(&model, &roles, &motion);
+    let leg = blocked.iter().find(|b| b.limb == "left leg").expect("the left leg is blocked");
+    assert!(leg.last - leg.first > 150, "{leg}");
+    assert!(leg.joints.iter().any(|j| j.name == "left_hip_pitch_joint" && j.lower), "{leg}");
+    assert!(leg.to_string().contains("cannot follow the human"), "{leg}");
+    let Some(walk) = lafan_walk() else { return };
+    let motion = solve(&walk);
+    assert_eq!(retarget::follow::blocked_limbs(&model, &roles, &motion), []);
+}

@@ -3,8 +3,11 @@
 
 One body, described once in body coordinates (metres; x = the subject's left, y = up,
 z = forward), is written in several naming conventions, hierarchies, units, up axes and rest
-poses. Every file has four frames: the subject walks forward, turns a little and bends both
-knees, so that the motion shows which way it faces. Pure Python, no dependencies.
+poses. Most files have four frames: the subject walks forward, turns a little and bends both
+knees, so that the motion shows which way it faces. Two carry a whole gait cycle of several
+seconds for the retargeting tests (`gait`): a walk (MakeHuman) and a sprint (Biovision), legs
+and arms swinging in opposition, the stance foot held still on the floor. Pure Python, no
+dependencies.
 """
 
 import math
@@ -90,11 +93,79 @@ def euler_zxy(m):
 # Body → file axes: columns are where the body's left, up and forward go.
 Y_UP = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]  # BVH norm: facing +Z, left = +X
 Z_UP_FACE_Y = [[-1, 0, 0], [0, 0, 1], [0, 1, 0]]  # 3ds Max / Unreal: up +Z, facing +Y
+Z_UP_FACE_NEG_Y = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]  # Blender / MakeHuman: up +Z, facing -Y
+
+# Gaits: stride frequency (Hz), hip swing and knee flexion amplitudes (degrees), arm swing,
+# elbow flexion, vertical bounce (m, for flight phases) and duration (s).
+GAITS = {
+    "walk": dict(freq=0.9, hip=24.0, hip_bias=4.0, knee_stance=8.0, knee_swing=55.0, ankle=12.0,
+                 arm=18.0, elbow=15.0, bounce=0.0, seconds=6.0),
+    "sprint": dict(freq=1.45, hip=38.0, hip_bias=6.0, knee_stance=15.0, knee_swing=105.0,
+                   ankle=20.0, arm=45.0, elbow=85.0, bounce=0.05, seconds=5.0),
+}
 
 
-def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying=False):
+def gait_pose(g, phase):
+    """Per (part, side): the joint's rotation in body axes at gait phase `phase` (radians of the
+    left leg's cycle; the right leg half a cycle later, each arm with the other leg)."""
+    out = {}
+    for side, offset in (("l", 0.0), ("r", math.pi)):
+        p = phase + offset
+        swing = max(0.0, math.cos(p))  # the hip moving forward: the swing phase
+        out[("thigh", side)] = rot("x", -(g["hip"] * math.sin(p) + g["hip_bias"]))
+        out[("shin", side)] = rot("x", g["knee_stance"] + g["knee_swing"] * swing ** 2)
+        out[("foot", side)] = rot("x", -g["ankle"] * math.sin(p + 0.6))
+        out[("upper_arm", side)] = rot("x", g["arm"] * math.sin(p))
+        out[("forearm", side)] = rot("x", -(g["elbow"] + 0.3 * g["elbow"] * swing))
+    return out
+
+
+def foot_points(pose, side):
+    """Ankle and toe (body coordinates, pelvis at its rest point) under `pose`."""
+    hip = point("thigh", side)
+    r = pose[("thigh", side)]
+    knee = add(hip, mat_vec(r, sub(point("shin", side), hip)))
+    r = mat_mul(r, pose[("shin", side)])
+    ankle = add(knee, mat_vec(r, sub(point("foot", side), point("shin", side))))
+    r = mat_mul(r, pose[("foot", side)])
+    toe = add(ankle, mat_vec(r, sub(point("toe", side), point("foot", side))))
+    return ankle, toe
+
+
+def gait_frames(name):
+    """Root translation (body axes), yaw (degrees) and joint rotations per frame, 30 fps: the
+    lowest foot point on the floor, the stance foot not sliding, a slow turn to the left."""
+    g = GAITS[name]
+    fps = 30.0
+    frames = []
+    forward, speed = 0.0, None
+    previous = None
+    for k in range(int(g["seconds"] * fps)):
+        phase = 2 * math.pi * g["freq"] * k / fps
+        pose = gait_pose(g, phase)
+        feet = {s: foot_points(pose, s) for s in "lr"}
+        # Height above the floor of each foot: ankle 8 cm, toe 2 cm when standing.
+        low = {s: min(feet[s][0][1] - 0.08, feet[s][1][1] - 0.02) for s in "lr"}
+        stance = min(low, key=low.get)
+        lift = -low[stance] + g["bounce"] * max(0.0, math.sin(2 * phase)) ** 2
+        ahead = max(feet[stance][0][2], feet[stance][1][2])
+        if previous is not None and previous[0] == stance:
+            step = previous[1] - ahead  # the stance foot stays put: the body moves over it
+            speed = step if speed is None else 0.8 * speed + 0.2 * step
+            forward += step if g["bounce"] == 0.0 or low[stance] < 0.01 else speed
+        elif speed is not None:
+            forward += speed
+        previous = (stance, ahead)
+        root = add(point("pelvis"), (0.0, lift, forward))
+        frames.append((root, 5.0 * k / fps, pose))
+    return frames
+
+
+def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying=False,
+          gait=None):
     """`joints`: (name, parent or None, body point key, side); End Sites are named None and
-    placed at their point. `shins`: names of the joints that bend as knees."""
+    placed at their point. `shins`: names of the joints that bend as knees. `gait`: a whole
+    gait cycle (see `GAITS`) instead of the four frames."""
     axes = mat_mul(rot("y", 0) if axes is None else axes, rot("y", yaw))
     # A zero pose lying on its back along +X: offsets turned by r0, undone by the root.
     r0 = rot("z", -90) if lying else rot("x", 0)
@@ -135,7 +206,21 @@ def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying
 
     emit(children[None][0], 0, None)
     rows = []
-    for k in range(4):
+    parts = {name: (key.split(":")[0], side) for name, _, key, side in joints if name}
+    for root, turn_deg, pose in (gait_frames(gait) if gait else []):
+        row = []
+        for name in order:
+            if name == order[0]:
+                row += [v / unit for v in mat_vec(axes, root)]
+                turn = mat_mul(mat_mul(axes, rot("y", turn_deg)), transpose(axes))
+                row += euler_zxy(mat_mul(turn, transpose(r0)))
+            elif parts[name] in pose:
+                local = mat_mul(mat_mul(axes, pose[parts[name]]), transpose(axes))
+                row += euler_zxy(mat_mul(mat_mul(r0, local), transpose(r0)))
+            else:
+                row += [0.0, 0.0, 0.0]
+        rows.append(" ".join(f"{v:.6f}" for v in row))
+    for k in range(0 if gait else 4):
         row = []
         for name in order:
             if name == order[0]:
@@ -451,6 +536,46 @@ def cmu_motionbuilder():
     return joints + out, ["LeftLeg", "RightLeg"]
 
 
+def makehuman():
+    # MakeHuman's default skeleton as Blender exports it (Z up, decimetres): `Root` carries the
+    # translation, `Hips` beside `Spine1` carries the legs through midline helpers `__UpLeg_L`,
+    # eyes and jaw under `Head`.
+    names = sided("{W}_{S}", {
+        "clavicle": "Clavicle", "upper_arm": "UpArm", "forearm": "LoArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "LoLeg", "foot": "Foot", "toe": "Toe"})
+    joints = [("Root", None, "pelvis", "l"), ("Hips", "Root", "pelvis", "l"),
+              ("Spine1", "Root", "spine", "l"), ("Spine2", "Spine1", "spine:2", "l"),
+              ("Spine3", "Spine2", "chest", "l"), ("Neck", "Spine3", "neck", "l"),
+              ("Head", "Neck", "head", "l"), (None, "Head", "head_end", "l"),
+              ("Eye_L", "Head", "head:eye", "l"), (None, "Eye_L", "head:eyetip", "l"),
+              ("Eye_R", "Head", "head:eye", "r"), (None, "Eye_R", "head:eyetip", "r"),
+              ("Jaw", "Head", "head:jaw", "l"), (None, "Jaw", "head:chin", "l")]
+    out = []
+    for j in limbs(names, "Hips", "Spine3"):
+        if j[0] in ("UpLeg_L", "UpLeg_R"):
+            helper = f"__{j[0]}"
+            out += [(helper, "Hips", "pelvis", j[3]), (j[0], helper, "thigh", j[3])]
+        else:
+            out.append(j)
+    return joints + out, ["LoLeg_L", "LoLeg_R"]
+
+
+def biovision():
+    # The classic 18-joint Biovision skeleton (LeftUpArm, LeftLowArm, LeftUpLeg, LeftLowLeg;
+    # inches, arms down), no toe joint: the foot ends in an End Site at the toes.
+    names = sided("{Side}{W}", {
+        "clavicle": "Collar", "upper_arm": "UpArm", "forearm": "LowArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "LowLeg", "foot": "Foot"})
+    joints = [("Hips", None, "pelvis", "l"), ("Chest", "Hips", "spine", "l"),
+              ("Neck", "Chest", "neck", "l"), ("Head", "Neck", "head", "l"),
+              (None, "Head", "head_end", "l")]
+    out = []
+    for j in limbs(names, "Hips", "Chest"):
+        # The End Site after the foot sits at the toes.
+        out.append((None, j[1], "toe", j[3]) if j[0] is None and j[2] == "toe_end" else j)
+    return joints + out, ["LeftLowLeg", "RightLowLeg"]
+
+
 def unrecognisable():
     # A robot arm: one chain, nothing like a body.
     joints = [("base", None, "pelvis", "l"), ("link1", "base", "spine", "l"),
@@ -496,6 +621,9 @@ def main():
     write("rigify_def_segments.bvh", *rigify_def(), unit=1.0)
     write("cmu_motionbuilder.bvh", *cmu_motionbuilder())
     write("unrecognisable_chain.bvh", *unrecognisable())
+    write("makehuman_zup_decimetres_walk.bvh", *makehuman(), axes=Z_UP_FACE_NEG_Y, unit=0.1,
+          gait="walk")
+    write("biovision_inches_sprint.bvh", *biovision(), unit=0.0254, gait="sprint")
 
 
 if __name__ == "__main__":

@@ -17,9 +17,13 @@ def name(kind, given, numbered):
     return f"{'link' if kind == 'body' else 'joint'}{counter[kind]}" if numbered else given
 
 
+# Every body weighs something: MuJoCo refuses moving bodies without mass and inertia.
+INERTIAL = '<inertial pos="0 0 0" mass="0.5" diaginertia="0.001 0.001 0.001"/>'
+
+
 def body(given, pos, inner, numbered, quat=None):
     q = f' quat="{quat}"' if quat else ""
-    return f'<body name="{name("body", given, numbered)}" pos="{pos}"{q}>{inner}</body>'
+    return f'<body name="{name("body", given, numbered)}" pos="{pos}"{q}>{INERTIAL}{inner}</body>'
 
 
 def hinge(given, axis, lo, hi, numbered):
