@@ -54,7 +54,7 @@ pub use straight::straighten_limbs;
 use std::collections::BTreeMap;
 
 use bvh::Bvh;
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 use forward::{Plan, ToWorld};
 use size::Landmarks;
@@ -119,6 +119,32 @@ pub fn recognise(bvh: &Bvh, given: &BTreeMap<Role, String>) -> Result<Humanoid, 
     let plan = Plan::new(bvh)?;
     check_finite(bvh)?;
     roles::recognise(&bvh.skeleton, &samples(&plan, bvh), given)
+}
+
+/// One sampled frame for [`recognise_posed`]: its index in the clip, then every joint's
+/// position and orientation (in skeleton order).
+pub type PosedFrame = (usize, Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
+
+/// [`recognise`] for a skeleton whose poses come from another forward kinematics (SMPL body
+/// models: crate `smpl`): its hierarchy, names and OFFSETs, its joints' positions in the
+/// zero pose (`rest`, every orientation the identity there) and a few frames of its motion
+/// (`frames`; up to 128 evenly spaced ones are enough), all in one set of axes and units.
+pub fn recognise_posed(
+    skeleton: &bvh::Skeleton,
+    rest: Vec<Vector3<f64>>,
+    frames: Vec<PosedFrame>,
+    given: &BTreeMap<Role, String>,
+) -> Result<Humanoid, Error> {
+    // The hierarchy's checks (a tree in parents-first order, finite OFFSETs).
+    Plan::new(&Bvh { skeleton: skeleton.clone(), motion: bvh::Motion::default() })?;
+    let n = skeleton.joints.len();
+    let bad = std::iter::once((rest.len(), n))
+        .chain(frames.iter().map(|(_, p, q)| (p.len(), q.len())))
+        .find(|&(p, q)| p != n || q != n);
+    if let Some((positions, orientations)) = bad {
+        return Err(Error::BodyShape { positions, orientations, num_frames: 1, num_bodies: n });
+    }
+    roles::recognise(skeleton, &roles::Samples { rest, frames }, given)
 }
 
 /// At most this many frames of a clip are looked at to recognise the humanoid.
