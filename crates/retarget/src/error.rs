@@ -61,6 +61,9 @@ pub enum Error {
         #[source]
         source: fk::markers::MarkerError,
     },
+    /// An SMPL-X / SMPL+H body model or AMASS motion that cannot be read or posed.
+    #[error(transparent)]
+    Smpl(#[from] smpl::Error),
     /// A C3D file that does not parse.
     #[error(transparent)]
     C3d(#[from] c3d::Error),

@@ -90,6 +90,7 @@ pub mod retargeter;
 pub mod robot_names;
 pub mod robot_roles;
 pub mod shipped;
+pub mod smpl;
 pub mod solver;
 pub mod targets;
 pub mod writers;

@@ -114,6 +114,8 @@ pub struct Retargeter {
     label: String,
     given: Option<IkConfig>,
     tuned: Option<IkConfig>,
+    /// The shipped robot's SMPL-X config (GMR's), for SMPL-X and SMPL+H motions.
+    smplx: Option<IkConfig>,
     options: RetargetOptions,
     stream_fps: f64,
     stream: Mutex<Option<Stream>>,
@@ -133,6 +135,7 @@ impl Retargeter {
         let mut retargeter = Retargeter::from_model(model, &shipped::robot_label(robot));
         retargeter.tuned = tuned;
         retargeter.notes = notes;
+        retargeter.smplx = shipped::smplx_config(robot).transpose()?;
         Ok(retargeter)
     }
 
@@ -161,6 +164,7 @@ impl Retargeter {
             label: label.to_owned(),
             given: None,
             tuned: None,
+            smplx: None,
             options: RetargetOptions::default(),
             stream_fps: 30.0,
             stream: Mutex::new(None),
@@ -249,6 +253,12 @@ impl Retargeter {
     #[must_use]
     pub fn tuned_config(&self) -> Option<&IkConfig> {
         self.tuned.as_ref()
+    }
+
+    /// The shipped robot's SMPL-X config (`configs/smplx_to_<key>.json`, GMR's), if it has one.
+    #[must_use]
+    pub fn smplx_config(&self) -> Option<&IkConfig> {
+        self.smplx.as_ref()
     }
 
     /// The config a BVH clip is retargeted with, and why ([`crate::derive::choose`]).

@@ -53,6 +53,23 @@ pub const ROBOTS: &[ShippedRobot] = &[
     shipped!("unitree_h1"),
 ];
 
+/// GMR's SMPL-X configs of the shipped robots that have one (`configs/smplx_to_<key>.json`,
+/// GMR's `smplx_to_*.json` reformatted), for SMPL-X and SMPL+H motions, by robot key.
+pub const SMPLX_CONFIGS: &[(&str, &str)] = &[
+    ("booster_t1_29dof", include_str!("../../../configs/smplx_to_booster_t1_29dof.json")),
+    ("unitree_g1", include_str!("../../../configs/smplx_to_unitree_g1.json")),
+];
+
+/// The SMPL-X config of the shipped robot `key` ([`SMPLX_CONFIGS`]), named by its path in
+/// the repository; `None` when it has none.
+#[must_use]
+pub fn smplx_config(key: &str) -> Option<Result<IkConfig, Error>> {
+    SMPLX_CONFIGS
+        .iter()
+        .find(|(k, _)| *k == key)
+        .map(|(k, text)| IkConfig::from_json_str(text, &format!("configs/smplx_to_{k}.json")))
+}
+
 /// The shipped robot `key`, if there is one.
 #[must_use]
 pub fn find(key: &str) -> Option<&'static ShippedRobot> {

@@ -1,0 +1,155 @@
+//! SMPL-X and SMPL+H motions (AMASS and the datasets in its format): the config choice and
+//! the solve, in both modes.
+//!
+//! - **Config**: the one given (bound to the body when role-named); else the shipped
+//!   robot's SMPL-X config (GMR's `smplx_to_*.json`, [`crate::shipped::smplx_config`]):
+//!   every SMPL-X and SMPL+H body model has smplx's joint names and the same joint frames
+//!   (the template's T-pose, Y up, facing +Z), which those configs are written for, so they
+//!   fit any SMPL source; else one derived from the robot's roles and the body's
+//!   ([`crate::derive::derive`]).
+//! - **Default solve**: the body model's FK at the file's rate ([`smpl::clip`]), its
+//!   recognised roles (the contacts read the `foot` and `toe` roles: `left_ankle`,
+//!   `left_foot`), the model's stature as the subject height.
+//! - **`--gmr`**: GMR's SMPL-X path exactly: its loader ([`smpl::gmr::offline_fast`]:
+//!   float32 parameters, jaw/eyes/hands zero, 30 fps as `get_smplx_data_offline_fast`
+//!   resamples), its subject height `1.66 + 0.1 β₀`, and its `smplx_to_robot.py`, which
+//!   retargets from the second resampled frame on (`i += 1` before the first use).
+
+// No panics on input (issue 15); tests may (clippy.toml).
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+
+use fk::HumanMotion;
+use mjcf::Model;
+use smpl::{BodyModel, SmplMotion};
+
+use crate::config::IkConfig;
+use crate::derive::{Choice, Chosen, HumanBody};
+use crate::motion::RobotMotion;
+use crate::pipeline::{ClipDiagnostics, SolveMode};
+use crate::robot_roles::RobotRoles;
+use crate::{Error, Retargeter};
+
+/// The first frame `--gmr` retargets: GMR's `smplx_to_robot.py` starts at frame 1.
+pub const GMR_FIRST_FRAME: usize = 1;
+
+/// The config for an SMPL clip (module docs); `robot` names the robot in messages.
+pub fn choose(
+    model: &Model,
+    robot: &str,
+    clip: &smpl::Clip,
+    given: Option<IkConfig>,
+    tuned: Option<&IkConfig>,
+) -> Result<Chosen, Error> {
+    let names = &clip.human.body_names;
+    if let Some(config) = given {
+        if !crate::derive::is_role_named(&config) {
+            let summary = format!("config {} as given", config.source);
+            return Ok(Chosen { config, choice: Choice::Given, summary });
+        }
+        let roles = RobotRoles::recognise(model)?;
+        let bound = crate::derive::bind(&config, &human_body(clip)?, model, &roles)?;
+        let summary = format!("config {} (role-named), bound to the body model", config.source);
+        return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
+    }
+    if let Some(tuned) = tuned {
+        if tuned.validate(model, names).is_ok() {
+            let summary = format!("config {} (tuned: SMPL joint names and frames)", tuned.source);
+            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
+        }
+    }
+    let roles = RobotRoles::recognise(model)?;
+    let source = format!("<derived for {robot}>");
+    let derived = crate::derive::derive(model, &roles, &human_body(clip)?, &source)?;
+    let summary = format!("config derived from the roles of {robot} and of the body model");
+    Ok(Chosen { config: derived, choice: Choice::Derived, summary })
+}
+
+fn human_body(clip: &smpl::Clip) -> Result<HumanBody, Error> {
+    HumanBody::from_motion(&clip.humanoid, &clip.human, clip.ground, clip.height, "the body model")
+}
+
+/// Frames `from..` of `human`.
+#[must_use]
+pub fn frames_from(human: &HumanMotion, from: usize) -> HumanMotion {
+    let nb = human.num_bodies();
+    let start = (from * nb).min(human.positions.len());
+    HumanMotion {
+        fps: human.fps,
+        body_names: human.body_names.clone(),
+        num_frames: human.num_frames.saturating_sub(from),
+        positions: human.positions.get(start..).unwrap_or_default().to_vec(),
+        orientations: human.orientations.get(start..).unwrap_or_default().to_vec(),
+    }
+}
+
+impl Retargeter {
+    /// The config an SMPL clip is retargeted with, and why ([`choose`]).
+    pub fn choose_smpl_config(&self, clip: &smpl::Clip) -> Result<Chosen, Error> {
+        choose(self.model(), self.label(), clip, self.given_config().cloned(), self.smplx_config())
+    }
+
+    /// Retargets an SMPL-X or SMPL+H motion posed with `body` (module docs: what each mode
+    /// does). `diag.human_inferred` ends with the config used.
+    pub fn retarget_smpl(
+        &self,
+        motion: &SmplMotion,
+        body: &BodyModel,
+    ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+        let in_file = |e: Error| Error::InFile {
+            path: motion.source.display().to_string(),
+            source: Box::new(e),
+        };
+        let gmr = self.options().mode == SolveMode::Gmr;
+        let clip = smpl::clip(body, motion).map_err(|e| in_file(e.into()))?;
+        let mut chosen = self.choose_smpl_config(&clip).map_err(in_file)?;
+        if gmr && chosen.choice == Choice::Tuned {
+            chosen.summary.push_str("; --gmr");
+        }
+        let mut options = self.options().clone();
+        let (human, height, source) = if gmr {
+            let resampled = smpl::gmr::offline_fast(body, motion, smpl::conventions::GMR_FPS)
+                .map_err(|e| in_file(e.into()))?;
+            let human = frames_from(&resampled, GMR_FIRST_FRAME);
+            let height = smpl::conventions::gmr_height(&motion.betas);
+            (human, height, "GMR's 1.66 + 0.1 · betas[0]".to_owned())
+        } else {
+            (clip.human.clone(), clip.height, clip.height_source.clone())
+        };
+        // The source's feet for the contact phases (both modes write them), by role.
+        for (role, joint) in clip.roles() {
+            options.fk.roles.entry(role).or_insert(joint);
+        }
+        if human.num_frames == 0 {
+            return Err(in_file(Error::InvalidOption(
+                "too few frames to retarget (GMR's path skips the first resampled frame)".into(),
+            )));
+        }
+        let (height, source) = match options.human_height {
+            Some(h) => (h, "given".to_owned()),
+            None => (height, source),
+        };
+        options.human_height = Some(height);
+        let (robot, mut diag) = match options.chunk {
+            Some(chunk) => crate::chunked::retarget_motion_chunked(
+                &human,
+                self.model(),
+                &chosen.config,
+                &options,
+                chunk,
+            ),
+            None => {
+                crate::pipeline::retarget_motion(&human, self.model(), &chosen.config, &options)
+            }
+        }
+        .map_err(in_file)?;
+        diag.human_height_source = source;
+        diag.human_inferred = format!(
+            "{} body model ({} joints), Z up, metres, {} fps; {}",
+            body.kind,
+            body.num_joints(),
+            motion.fps,
+            chosen.summary
+        );
+        Ok((robot, diag))
+    }
+}
