@@ -13,8 +13,9 @@ use crate::batch::{self, ClipResult, Plan, Shard, Summary};
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
-    /// Directory tree of BVH, FBX (each file's take with the most motion) and C3D files;
-    /// relative paths are mirrored into the output directory. Required unless
+    /// Directory tree of BVH, FBX (each file's take with the most motion), C3D and AMASS
+    /// (`*_stageii.npz`, `*_poses.npz`; `shape.npz` and other `.npz` files are skipped)
+    /// files; relative paths are mirrored into the output directory. Required unless
     /// --merge-summaries.
     #[arg(value_name = "IN_DIR", required_unless_present = "merge_summaries")]
     pub input: Option<PathBuf>,
@@ -69,6 +70,8 @@ pub struct BatchArgs {
     /// Frames solved before each chunk and thrown away, so that its seam is smooth.
     #[arg(long, value_name = "FRAMES", default_value_t = 60, requires = "chunk_frames")]
     pub lead_in: usize,
+    #[command(flatten)]
+    pub smpl: crate::cmd_smpl::ModelArgs,
     /// Merge shard summaries (summary-shard-K-of-N.json files) into one JSON file (-o).
     #[arg(long, num_args = 1.., value_name = "SUMMARY", conflicts_with_all = ["input", "robot", "config", "shard"])]
     pub merge_summaries: Vec<PathBuf>,
@@ -98,7 +101,13 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     };
     let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;
     job.fps = args.fps;
-    let files = batch::select_shard(batch::walk(&input, &["bvh", "fbx", "c3d"])?, args.shard);
+    job.body_models = args.smpl.models();
+    job.gender = args.smpl.gender;
+    let files: Vec<PathBuf> = batch::walk(&input, &["bvh", "fbx", "c3d", "npz"])?
+        .into_iter()
+        .filter(|f| !is_npz(f) || smpl::conventions::is_motion_file_name(f))
+        .collect();
+    let files = batch::select_shard(files, args.shard);
     let jobs =
         args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     eprintln!(
@@ -163,6 +172,9 @@ struct Job {
     format: Format,
     /// `--fps`: resample every output.
     fps: Option<f64>,
+    /// The body models of AMASS clips (`--body-model`), each read once, and `--gender`.
+    body_models: smpl::BodyModels,
+    gender: Option<smpl::Gender>,
 }
 
 impl Job {
@@ -188,6 +200,8 @@ impl Job {
             config_path: config.map(Path::to_path_buf),
             format,
             fps: None,
+            body_models: smpl::BodyModels::default(),
+            gender: None,
         })
     }
 
@@ -210,6 +224,8 @@ impl Job {
                 .retarget_fbx_with(&clip, &chosen)
                 .with_context(|| format!("{}: retargeting", src.display()))?;
             (motion, diag, chosen.config)
+        } else if is_npz(src) {
+            self.convert_smpl(src)?
         } else {
             let bvh = bvh::from_path(src)?;
             let chosen = self
@@ -245,6 +261,25 @@ impl Job {
 }
 
 impl Job {
+    /// An AMASS clip posed with its body model (as the main command's `--smplx`).
+    fn convert_smpl(
+        &self,
+        src: &Path,
+    ) -> anyhow::Result<(retarget::RobotMotion, retarget::ClipDiagnostics, IkConfig)> {
+        let motion = smpl::SmplMotion::from_path(src)?;
+        let model = self.body_models.for_motion(&motion, self.gender)?;
+        let clip = smpl::clip(&model, &motion).with_context(|| format!("{}", src.display()))?;
+        let chosen = self
+            .retargeter
+            .choose_smpl_config(&clip)
+            .with_context(|| format!("{}: choosing the IK config", src.display()))?;
+        let (robot, diag) = self
+            .retargeter
+            .retarget_smpl_with(&motion, &model, &clip, &chosen)
+            .with_context(|| format!("{}: retargeting", src.display()))?;
+        Ok((robot, diag, chosen.config))
+    }
+
     /// A C3D clip through the marker config's virtual bodies (as the main command's `--c3d`).
     fn convert_c3d(
         &self,
@@ -272,6 +307,10 @@ impl Job {
         diag.human_height_source = clip.height_source;
         Ok((motion, diag, config))
     }
+}
+
+fn is_npz(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"))
 }
 
 /// Whether the JSON config at `path` has a `marker_bodies` table (a marker config).

@@ -15,8 +15,8 @@ use retarget::{
 
 #[derive(Args, Debug)]
 pub struct MainArgs {
-    /// BVH motion capture file to retarget (this, --fbx or --c3d is required).
-    #[arg(long, value_name = "FILE", required_unless_present_any = ["c3d", "fbx"])]
+    /// BVH motion capture file to retarget (this, --fbx, --c3d or --smplx is required).
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["c3d", "fbx", "smplx"])]
     pub bvh: Option<PathBuf>,
     /// FBX file to retarget (Mixamo, MotionBuilder, Maya, 3ds Max, Blender exports): one take,
     /// see --take.
@@ -30,6 +30,13 @@ pub struct MainArgs {
     /// with `marker_bodies`, e.g. configs/c3d_plugingait_to_unitree_g1.json.
     #[arg(long, value_name = "FILE", conflicts_with = "bvh", requires = "config")]
     pub c3d: Option<PathBuf>,
+    /// AMASS motion file to retarget: SMPL-X stage-ii (`*_stageii.npz`) or SMPL+H
+    /// (`*_poses.npz`), told apart by content; needs the body model (--body-model or
+    /// $RETARGET_BODY_MODELS). Default output: `<stem>_<robot>.npz` beside it.
+    #[arg(long, visible_alias = "smplh", value_name = "FILE", conflicts_with_all = ["bvh", "c3d", "fbx"])]
+    pub smplx: Option<PathBuf>,
+    #[command(flatten)]
+    pub smpl: crate::cmd_smpl::ModelArgs,
     /// Robot (required): a shipped name (see `retarget robots`) or a path to an MJCF (.xml)
     /// or URDF (.urdf) file.
     #[arg(long, required = true)]
@@ -91,15 +98,24 @@ pub fn shipped_config(key: &str) -> Option<anyhow::Result<IkConfig>> {
 }
 
 pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
-    let input = args.bvh.clone().or_else(|| args.fbx.clone()).or_else(|| args.c3d.clone());
+    let input = args
+        .bvh
+        .clone()
+        .or_else(|| args.fbx.clone())
+        .or_else(|| args.c3d.clone())
+        .or_else(|| args.smplx.clone());
     let (Some(input), Some(robot)) = (input, args.robot.clone()) else {
         eprintln!(
-            "usage: retarget --bvh FILE | --fbx FILE | --c3d FILE --config C --robot NAME [-o OUT]   (see `retarget --help`)"
+            "usage: retarget --bvh FILE | --fbx FILE | --c3d FILE --config C | --smplx FILE --robot NAME [-o OUT]   (see `retarget --help`)"
         );
         return Ok(ExitCode::from(2));
     };
     let format = parse_format(args.format.as_deref())?;
-    let output = output_path(&input, args.output.as_deref(), format);
+    let mut output = output_path(&input, args.output.as_deref(), format);
+    if args.smplx.is_some() && args.output.is_none() {
+        let ext = format.map_or("npz", Format::extension);
+        output = crate::cmd_smpl::default_output(&input, &robot_label(&robot), ext);
+    }
     let started = Instant::now();
     let mode = solve_mode(args.gmr, args.both_ways);
     let chunk = args
@@ -115,7 +131,13 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     for note in retargeter.robot_notes() {
         println!("robot: {note}");
     }
-    let (motion, diag) = if args.c3d.is_some() {
+    let (motion, diag) = if args.smplx.is_some() {
+        if let Some(path) = &args.config {
+            retargeter = retargeter.with_config(IkConfig::from_file(path)?);
+        }
+        let models = args.smpl.models();
+        crate::cmd_smpl::retarget_file(&retargeter, &input, &models, args.smpl.gender)?
+    } else if args.c3d.is_some() {
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
         let config = IkConfig::from_file(config_path)?;
         let markers = MarkerConfig::from_file(config_path)?;

@@ -13,6 +13,7 @@ mod cmd_fbx;
 mod cmd_report;
 mod cmd_retarget;
 mod cmd_robot;
+mod cmd_smpl;
 mod cmd_view;
 mod shipped;
 mod view;
@@ -21,7 +22,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// Retarget human motion capture (BVH, FBX, C3D) onto humanoid robots described in MJCF.
+/// Retarget human motion capture (BVH, FBX, C3D, AMASS SMPL-X / SMPL+H) onto humanoid robots described in MJCF.
 #[derive(Parser, Debug)]
 #[command(
     name = "retarget",
@@ -31,6 +32,7 @@ use clap::{Parser, Subcommand};
     override_usage = "retarget --bvh <FILE> --robot <ROBOT> [OPTIONS]\n       \
                       retarget --fbx <FILE> [--take <NAME|N>] --robot <ROBOT> [OPTIONS]\n       \
                       retarget --c3d <FILE> --config <FILE> --robot <ROBOT> [OPTIONS]\n       \
+                      retarget --smplx <FILE> --robot <ROBOT> [--body-model DIR] [OPTIONS]\n       \
                       retarget <COMMAND>"
 )]
 struct Cli {
@@ -52,6 +54,9 @@ enum Command {
     /// Inspect FBX files, convert a take to BVH, show the skeleton's roles.
     #[command(subcommand)]
     Fbx(cmd_fbx::FbxCommand),
+    /// Inspect AMASS motion files (SMPL-X, SMPL+H) and their body models.
+    #[command(subcommand)]
+    Smpl(cmd_smpl::SmplCommand),
     /// List the robots and configs shipped with the tool.
     Robots,
     /// Inspect one robot model (shipped name, MJCF or URDF path).
@@ -72,6 +77,7 @@ fn main() -> ExitCode {
         Some(Command::Bvh(cmd)) => cmd_bvh::run(cmd),
         Some(Command::C3d(cmd)) => cmd_c3d::run(cmd),
         Some(Command::Fbx(cmd)) => cmd_fbx::run(cmd),
+        Some(Command::Smpl(cmd)) => cmd_smpl::run(cmd),
         Some(Command::Robots) => cmd_robot::list(),
         Some(Command::Robot(cmd)) => cmd_robot::run(cmd),
         Some(Command::View(args)) => cmd_view::run(args),

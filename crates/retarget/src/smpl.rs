@@ -99,12 +99,25 @@ impl Retargeter {
             path: motion.source.display().to_string(),
             source: Box::new(e),
         };
-        let gmr = self.options().mode == SolveMode::Gmr;
         let clip = smpl::clip(body, motion).map_err(|e| in_file(e.into()))?;
-        let mut chosen = self.choose_smpl_config(&clip).map_err(in_file)?;
-        if gmr && chosen.choice == Choice::Tuned {
-            chosen.summary.push_str("; --gmr");
-        }
+        let chosen = self.choose_smpl_config(&clip).map_err(in_file)?;
+        self.retarget_smpl_with(motion, body, &clip, &chosen)
+    }
+
+    /// [`Retargeter::retarget_smpl`] with the clip posed ([`smpl::clip`]) and the config
+    /// chosen ([`Retargeter::choose_smpl_config`]) already.
+    pub fn retarget_smpl_with(
+        &self,
+        motion: &SmplMotion,
+        body: &BodyModel,
+        clip: &smpl::Clip,
+        chosen: &Chosen,
+    ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+        let in_file = |e: Error| Error::InFile {
+            path: motion.source.display().to_string(),
+            source: Box::new(e),
+        };
+        let gmr = self.options().mode == SolveMode::Gmr;
         let mut options = self.options().clone();
         let (human, height, source) = if gmr {
             let resampled = smpl::gmr::offline_fast(body, motion, smpl::conventions::GMR_FPS)
@@ -149,7 +162,7 @@ impl Retargeter {
             body.num_joints(),
             motion.fps,
             chosen.summary
-        );
+        ) + if gmr { "; --gmr" } else { "" };
         Ok((robot, diag))
     }
 }
