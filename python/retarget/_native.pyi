@@ -124,6 +124,23 @@ class Retargeter:
     def retarget_bvh(self, path: PathLike) -> Motion: ...
     def retarget_fbx(self, path: PathLike, take: Optional[Union[str, int]] = None) -> Motion:
         """One take (name or index; default: the one with the most motion)."""
+    def retarget_smplx(
+        self,
+        path: Optional[PathLike] = None,
+        *,
+        body_model: Optional[PathLike] = None,
+        gender: Optional[str] = None,
+        poses: Optional[npt.ArrayLike] = None,
+        trans: Optional[npt.ArrayLike] = None,
+        betas: Optional[npt.ArrayLike] = None,
+        fps: Optional[float] = None,
+    ) -> Motion:
+        """An AMASS motion (SMPL-X ``*_stageii.npz`` or SMPL+H ``*_poses.npz``), or its
+        parameters as arrays (``poses`` N × 165 / N × 156 axis-angle, ``trans`` N × 3,
+        ``betas``, ``fps``); the body model folder from ``body_model`` or
+        ``$RETARGET_BODY_MODELS``."""
+    def select_config(self, source: str) -> None:
+        """Use the shipped config for ``"bvh_lafan1"`` or ``"smplx"`` (GMR's ``src_human``)."""
     def retarget_c3d(self, path: PathLike, config: PathLike) -> Motion:
         """With a marker-driven IK config (``marker_bodies`` + IK tables)."""
     def retarget_frames(self, frames: Sequence[HumanData], fps: float = 30.0) -> Motion:
@@ -137,6 +154,10 @@ class Retargeter:
 
 def load_bvh_gmr(path: PathLike, format: str = "lafan1") -> Tuple[List[Dict[str, List[npt.NDArray[np.float64]]]], float]: ...
 def load_fbx_frames(path: PathLike, take: Optional[Union[str, int]] = None) -> Tuple[List[Dict[str, List[npt.NDArray[np.float64]]]], float, str]: ...
+def load_smplx_gmr(
+    path: PathLike, body_model: Optional[PathLike], tgt_fps: float = 30.0, gender: Optional[str] = None
+) -> Tuple[List[Dict[str, Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]], float, float]:
+    """GMR's SMPL-X human data resampled to ``tgt_fps``: ``(frames, fps, human_height)``."""
 def batch(
     paths: Sequence[PathLike],
     robot: str,

@@ -10,7 +10,15 @@ targets, weights, damping, stopping rule and exact QP; our parity test holds it 
 GMR's own output on the LAFAN1 walk). ``load_bvh_file`` returns what GMR's loader returns; ``load_optitrack_fbx_motion_file`` reads
 an ``.fbx`` file itself into the frames GMR's FBX path (FBX SDK + poselib pickle) hands over.
 
-Differences: only GMR's ``bvh_lafan1`` configs ship (``src_human="bvh_lafan1"``); the solver is
+SMPL-X (AMASS): ``load_smplx_file`` and ``get_smplx_data_offline_fast`` return what GMR's do
+(the human data to 1e-6 m of GMR's own, float32 smplx), and ``src_human="smplx"`` takes GMR's
+``smplx_to_*`` config where one ships (unitree_g1, booster_t1_29dof):
+
+>>> from retarget.gmr import load_smplx_file, get_smplx_data_offline_fast       # doctest: +SKIP
+>>> data, body_model, output, height = load_smplx_file("walk_stageii.npz", "body_models")  # doctest: +SKIP
+>>> frames, fps = get_smplx_data_offline_fast(data, body_model, output, tgt_fps=30)  # doctest: +SKIP
+
+Differences: only GMR's ``bvh_lafan1`` configs and the ``smplx`` configs above ship; the solver is
 exact whatever ``solver`` names (GMR: daqp); ``use_velocity_limit`` changes nothing (GMR passes
 its velocity limits into mink's ``safety_break`` argument, so GMR never applies them either);
 nothing is printed (``verbose``); there is no MuJoCo model (``model``, ``configuration``).
@@ -26,11 +34,19 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["GeneralMotionRetargeting", "load_bvh_file", "load_fbx_file", "load_optitrack_fbx_motion_file"]
+__all__ = [
+    "GeneralMotionRetargeting",
+    "load_bvh_file",
+    "load_fbx_file",
+    "load_optitrack_fbx_motion_file",
+    "load_smplx_file",
+    "get_smplx_data_offline_fast",
+]
 
 #: GMR's ``src_human`` names we have configs for, by robot: GMR's ``IK_CONFIG_DICT``.
 IK_CONFIG_DICT: Dict[str, Dict[str, str]] = {
     "bvh_lafan1": {key: f"configs/bvh_lafan1_to_{key}.json" for key in _native.shipped_robots()},
+    "smplx": {key: f"configs/smplx_to_{key}.json" for key in ("booster_t1_29dof", "unitree_g1")},
 }
 
 HumanData = Mapping[str, Sequence[Any]]
@@ -69,6 +85,57 @@ def load_fbx_file(fbx_file: "os.PathLike[str] | str", take: "str | int | None" =
     return frames, fps
 
 
+class SmplxBodyModel:
+    """What ``load_smplx_file`` returns in place of smplx's body model: where the model files
+    are (the folder holding ``smplx/``, or one model ``.npz``) and the gender used."""
+
+    def __init__(self, path: "os.PathLike[str] | str", gender: str) -> None:
+        self.path = os.fspath(path)
+        self.gender = gender
+
+    def __repr__(self) -> str:
+        return f"SmplxBodyModel({self.path!r}, gender={self.gender!r})"
+
+
+class SmplxOutput:
+    """What ``load_smplx_file`` returns in place of smplx's output: the motion file it poses
+    (``get_smplx_data_offline_fast`` computes the joints from it)."""
+
+    def __init__(self, smplx_file: "os.PathLike[str] | str") -> None:
+        self.smplx_file = os.fspath(smplx_file)
+
+
+def load_smplx_file(
+    smplx_file: "os.PathLike[str] | str", smplx_body_model_path: "os.PathLike[str] | str"
+) -> Tuple[Any, SmplxBodyModel, SmplxOutput, float]:
+    """GMR's ``general_motion_retargeting.utils.smpl.load_smplx_file``.
+
+    Returns ``(smplx_data, body_model, smplx_output, human_height)``: the file's arrays
+    (``numpy.load``), the body model (``smplx_body_model_path`` is the folder that holds
+    ``smplx/SMPLX_NEUTRAL.npz`` etc., as for ``smplx.create``; the gender is the file's), the
+    posed output (computed lazily by ``get_smplx_data_offline_fast``) and GMR's subject height
+    ``1.66 + 0.1 * betas[0]``.
+    """
+    smplx_data = np.load(os.fspath(smplx_file))
+    betas = np.asarray(smplx_data["betas"], dtype=float).reshape(-1)
+    human_height = 1.66 + 0.1 * float(betas[0]) if betas.size else 1.66
+    body_model = SmplxBodyModel(smplx_body_model_path, str(smplx_data["gender"]))
+    return smplx_data, body_model, SmplxOutput(smplx_file), human_height
+
+
+def get_smplx_data_offline_fast(
+    smplx_data: Any, body_model: SmplxBodyModel, smplx_output: SmplxOutput, tgt_fps: float = 30
+) -> Tuple[List[Dict[str, Tuple[np.ndarray, np.ndarray]]], float]:
+    """GMR's ``get_smplx_data_offline_fast``: per frame ``{joint: (position, wxyz quaternion)}``
+    for the model's 55 joints, resampled to ``tgt_fps`` as GMR does (frame skip, linear
+    positions, slerped local rotations chained again), and the resulting rate."""
+    del smplx_data  # the arrays are read again from the file, by the library
+    frames, fps, _ = _native.load_smplx_gmr(
+        smplx_output.smplx_file, body_model.path, float(tgt_fps), body_model.gender
+    )
+    return frames, fps
+
+
 class GeneralMotionRetargeting:
     """GMR's ``GeneralMotionRetargeting``: ``retarget(human_data)`` solves one frame,
     warm-started from the previous one, and returns the robot's ``qpos``."""
@@ -96,6 +163,7 @@ class GeneralMotionRetargeting:
         self.verbose = verbose
         self.max_iter = 10
         self._retargeter = _native.Retargeter(tgt_robot, mode="gmr", human_height=actual_human_height)
+        self._retargeter.select_config(src_human)
         ik_config = json.loads(self._retargeter.config_json())
         ratio = 1.0 if actual_human_height is None else actual_human_height / ik_config["human_height_assumption"]
         self.ik_match_table1 = ik_config["ik_match_table1"]

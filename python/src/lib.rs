@@ -6,6 +6,8 @@
 // No panics on input: a panic would reach Python as `PanicException`, not a `RetargetError`.
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
+mod smpl;
+
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};
 
@@ -187,6 +189,60 @@ impl Retargeter {
         let (motion, diag) =
             py.detach(|| inner.retarget_c3d_file(&path, &config)).map_err(to_py)?;
         Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Retargets an AMASS motion: a file (SMPL-X stage-ii ``*_stageii.npz`` or SMPL+H
+    /// ``*_poses.npz``, told apart by content) or the same parameters as arrays (``poses``
+    /// N × 165 SMPL-X or N × 156 SMPL+H axis-angle in the model's joint order, ``trans``
+    /// N × 3, ``betas``, ``fps``). ``body_model``: the folder holding ``smplx/`` and
+    /// ``smplh/`` (or one model ``.npz``); default ``$RETARGET_BODY_MODELS``. ``gender``
+    /// overrides the file's.
+    #[pyo3(signature = (path=None, *, body_model=None, gender=None, poses=None, trans=None, betas=None, fps=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn retarget_smplx(
+        &self,
+        py: Python<'_>,
+        path: Option<PathBuf>,
+        body_model: Option<PathBuf>,
+        gender: Option<&str>,
+        poses: Option<Bound<'_, PyAny>>,
+        trans: Option<Bound<'_, PyAny>>,
+        betas: Option<Bound<'_, PyAny>>,
+        fps: Option<f64>,
+    ) -> PyResult<Motion> {
+        let arrays = match (&poses, &trans) {
+            (Some(poses), Some(trans)) => {
+                Some(smpl::Arrays { poses, trans, betas: betas.as_ref(), fps })
+            }
+            (None, None) => None,
+            _ => return Err(PyValueError::new_err("poses and trans go together")),
+        };
+        let inner = &self.inner;
+        let (motion, diag) = smpl::retarget_smplx(py, inner, path, arrays, body_model, gender)?;
+        Ok(Motion::new(motion, diag, inner.shared_model()))
+    }
+
+    /// Use the shipped robot's config for ``source``: ``"bvh_lafan1"`` (GMR's LAFAN1 config,
+    /// the default for frames) or ``"smplx"`` (GMR's ``smplx_to_*`` config), as GMR's
+    /// ``src_human`` chooses it.
+    fn select_config(&mut self, source: &str) -> PyResult<()> {
+        let config = match source {
+            "bvh_lafan1" => self.inner.tuned_config().cloned(),
+            "smplx" => self.inner.smplx_config().cloned(),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "source {other:?}: expected \"bvh_lafan1\" or \"smplx\""
+                )))
+            }
+        };
+        let config = config.ok_or_else(|| {
+            RetargetError::new_err(format!(
+                "robot {}: no {source} config ships",
+                self.inner.label()
+            ))
+        })?;
+        self.inner.set_config(config);
+        Ok(())
     }
 
     /// Retargets a clip given as frames of ``{body: (position, wxyz quaternion)}`` (GMR's
@@ -708,6 +764,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RetargetError", m.py().get_type::<RetargetError>())?;
     m.add_function(wrap_pyfunction!(load_bvh_gmr, m)?)?;
     m.add_function(wrap_pyfunction!(load_fbx_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(smpl::load_smplx_gmr, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;
     m.add_function(wrap_pyfunction!(shipped_robots, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

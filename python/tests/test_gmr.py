@@ -77,7 +77,7 @@ def test_gmrs_attributes_and_refusals():
         assert scale == pytest.approx(unscaled.human_scale_table[body] * 1.1)
     assert gmr.robot_body_names["world"] == 0 and gmr.robot_dof_names["left_hip_pitch_joint"] == 6
     with pytest.raises(KeyError):
-        GMR(src_human="smplx", tgt_robot="unitree_g1")
+        GMR(src_human="smplx", tgt_robot="unitree_h1")  # GMR has smplx_to_h1; we do not ship it
     with pytest.raises(KeyError):
         GMR(src_human="bvh_lafan1", tgt_robot="no_such_robot")
     with pytest.raises(NotImplementedError):

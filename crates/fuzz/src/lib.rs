@@ -20,6 +20,7 @@
 //! than [`ALLOCATION_LIMIT`] is an abort (the guard allocator saves the input and refuses,
 //! which aborts the process: this is how a count read from a file and trusted shows up).
 
+pub mod amass;
 pub mod fbx_target;
 pub mod guard;
 mod mutate;

@@ -23,6 +23,7 @@ pub fn all() -> Vec<Box<dyn Target>> {
         Box::new(ConfigTarget),
         Box::new(NpzTarget),
         Box::new(crate::fbx_target::FbxTarget),
+        Box::new(crate::amass::AmassTarget),
     ]
 }
 

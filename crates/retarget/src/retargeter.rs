@@ -187,6 +187,12 @@ impl Retargeter {
         self
     }
 
+    /// [`Retargeter::with_config`] in place.
+    pub fn set_config(&mut self, config: IkConfig) {
+        self.given = Some(config);
+        self.reset();
+    }
+
     /// Replace the options.
     #[must_use]
     pub fn with_options(mut self, options: RetargetOptions) -> Retargeter {

@@ -55,6 +55,16 @@ impl BodyModel {
         read(&mut npz, kind)
     }
 
+    /// [`BodyModel::from_path`] on the bytes of a model `.npz` (`name` is used in errors).
+    pub fn from_bytes(
+        bytes: &[u8],
+        name: &Path,
+        kind: Option<ModelKind>,
+    ) -> Result<BodyModel, Error> {
+        let mut npz = Npz::new(std::io::Cursor::new(bytes), name)?;
+        read(&mut npz, kind)
+    }
+
     /// The model of `kind` and `gender` under the body model folder `dir` (the folder that
     /// holds `smplx/` and `smplh/`, as `smplx.create` takes it; the `smplx` or `smplh/<gender>`
     /// folder itself is accepted too). A missing file is an error naming the path expected
