@@ -110,9 +110,13 @@ fn help_names_required_arguments_and_describes_every_argument() {
     let main = stdout(&retarget(&["--help"]));
     assert!(main.contains("Usage: retarget --bvh <FILE> --robot <ROBOT> [OPTIONS]"), "{main}");
     assert!(main.contains("retarget --c3d <FILE> --config <FILE> --robot <ROBOT>"), "{main}");
+    assert!(main.contains("retarget --smplx <FILE> --robot <ROBOT>"), "{main}");
     let entries = help_entries(&main);
     assert!(entries["--robot <ROBOT>"].starts_with("Robot (required)"), "{entries:?}");
-    assert!(entries["--bvh <FILE>"].contains("this, --fbx or --c3d is required"), "{entries:?}");
+    assert!(
+        entries["--bvh <FILE>"].contains("this, --fbx, --c3d or --smplx is required"),
+        "{entries:?}"
+    );
     assert!(main.contains("retarget --fbx <FILE> [--take <NAME|N>] --robot <ROBOT>"), "{main}");
     assert!(entries["--take <NAME|N>"].contains("the take with the most motion"), "{entries:?}");
     let commands = [
@@ -128,6 +132,8 @@ fn help_names_required_arguments_and_describes_every_argument() {
         "fbx bvh",
         "fbx fk",
         "fbx map",
+        "smpl info",
+        "smpl fk",
         "robot info",
         "robot check",
         "robots",
@@ -208,6 +214,8 @@ fn main_command_and_batch_take_the_same_options() {
         "--lead-in <FRAMES>",
         "--gmr",
         "--both-ways",
+        "--body-model <DIR>",
+        "--gender <GENDER>",
     ];
     for option in shared {
         assert!(main.contains_key(option), "main command lacks {option}: {main:?}");
@@ -221,7 +229,7 @@ fn main_command_and_batch_take_the_same_options() {
     }
     assert!(
         batch["[IN_DIR]"].starts_with(
-            "Directory tree of BVH, FBX (each file's take with the most motion) and C3D"
+            "Directory tree of BVH, FBX (each file's take with the most motion), C3D and AMASS"
         ),
         "{batch:?}"
     );
