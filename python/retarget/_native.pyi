@@ -77,10 +77,6 @@ class Motion:
         """Pelvis height off its target with the config's weights (m, or None) and the
         share of the default solve's trunk-and-leg reweighing applied."""
     @property
-    def smoothing(self) -> Tuple[Optional[float], int]:
-        """The robot's standing leg length (m, or None) and the default solve's smoothing
-        passes at 30 frames/s (more for legs under 0.55 m; 0 for GMR's solve)."""
-    @property
     def uncrossed(self) -> List[Tuple[int, int]]:
         """Frames (first, last) of the human's crossed steps the robot could not stand in,
         planned side by side and solved again (default solve; empty otherwise)."""
@@ -108,7 +104,7 @@ class Retargeter:
         human_height: Optional[float] = None,
         fps: float = 30.0,
     ) -> None:
-        """``mode``: ``"default"`` (planted feet, constraints, smoothing), ``"gmr"`` (GMR's
+        """``mode``: ``"default"`` (the trajectory solve: planted feet, constraints, smooth accelerations, dynamics), ``"gmr"`` (GMR's
         exact solve), ``"causal"`` (what ``step`` runs, on a whole clip) or ``"both_ways"``
         (the default, also solved backwards where that tracks better: ``--both-ways``)."""
     @property

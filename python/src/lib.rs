@@ -556,14 +556,6 @@ impl Motion {
         (self.diag.pelvis_offset, self.diag.reweigh_share)
     }
 
-    /// The robot's standing leg length (m, ``None`` without two feet) and the passes of the
-    /// default solve's smoothing filter at 30 frames/s it gave (legs under 0.55 m get more;
-    /// 0 for GMR's solve and streams).
-    #[getter]
-    fn smoothing(&self) -> (Option<f64>, usize) {
-        (self.diag.leg_length, self.diag.smoothing_passes)
-    }
-
     /// Frames ``(first, last)`` of the crossed steps of the human's that the robot could not
     /// stand in, planned uncrossed and solved again (default solve; empty otherwise).
     #[getter]

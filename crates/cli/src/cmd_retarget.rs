@@ -258,12 +258,6 @@ fn print_summary(
             100.0 * diag.reweigh_share
         );
     }
-    if let (Some(leg), true) = (diag.leg_length, diag.smoothing_passes > 0) {
-        println!(
-            "default solve: legs {:.2} m long, trajectory smoothed over {} passes at 30 frames/s",
-            leg, diag.smoothing_passes
-        );
-    }
     if !diag.uncrossed.is_empty() {
         let list: Vec<String> =
             diag.uncrossed.iter().map(|r| format!("{}-{}", r.start, r.end - 1)).collect();

@@ -325,9 +325,74 @@ impl Model {
     }
 }
 
+impl Model {
+    /// `mj_differentiatePos`: the velocity `qvel` (length `nv`) that [`Model::integrate_pos`]
+    /// takes from `from` to `to` in time `dt`: hinge and slide coordinates and the free joint's
+    /// translation by difference (world frame), ball joints and the free joint's rotation as
+    /// the body-frame rotation vector of `from⁻¹ · to` (the shorter way round), over `dt`.
+    /// Slices shorter than `nq`/`nv`, or `dt` not positive, leave `qvel` unchanged.
+    pub fn differentiate_pos(&self, qvel: &mut [f64], dt: f64, from: &[f64], to: &[f64]) {
+        if from.len() < self.nq || to.len() < self.nq || qvel.len() < self.nv || dt <= 0.0 {
+            return;
+        }
+        for joint in &self.joints {
+            let (mut a, mut v) = (joint.qpos_adr, joint.dof_adr);
+            match joint.kind {
+                JointType::Hinge | JointType::Slide => qvel[v] = (to[a] - from[a]) / dt,
+                JointType::Ball | JointType::Free => {
+                    if joint.kind == JointType::Free {
+                        for k in 0..3 {
+                            qvel[v + k] = (to[a + k] - from[a + k]) / dt;
+                        }
+                        a += 3;
+                        v += 3;
+                    }
+                    let (q0, q1) =
+                        (quat_from_slice(&from[a..a + 4]), quat_from_slice(&to[a..a + 4]));
+                    let w = (q0.inverse() * q1).scaled_axis() / dt;
+                    qvel[v..v + 3].copy_from_slice(w.as_slice());
+                }
+            }
+        }
+    }
+}
+
 /// `mju_quatIntegrate`: `q ← normalize(q) · exp(ω dt / 2)` with ω in the rotated frame.
 fn quat_integrate(q: &[f64], omega: &Vector3<f64>, dt: f64) -> UnitQuaternion<f64> {
     let n = omega.norm();
     let rot = if n < 1e-15 { UnitQuaternion::identity() } else { axis_angle(&(omega / n), dt * n) };
     quat_from_slice(q) * rot
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::Model;
+
+    /// `differentiate_pos` undoes `integrate_pos`, a turn of more than half a turn of the
+    /// double cover (the quaternion negated) included.
+    #[test]
+    fn differentiating_undoes_integrating() {
+        let m = Model::from_xml_str(
+            r#"<mujoco><worldbody><body><freejoint/><geom size="0.1"/>
+                 <body><joint type="ball"/><geom size="0.1"/>
+                 <body><joint axis="0 1 0"/><geom size="0.1"/></body></body>
+               </body></worldbody></mujoco>"#,
+            None,
+        )
+        .unwrap();
+        let mut q0 = m.qpos0.clone();
+        m.integrate_pos(&mut q0, &[0.3, -0.2, 0.1, 0.4, -0.7, 0.2, 0.1, 0.5, -0.3, 0.8], 1.0);
+        let v = [0.5, 0.1, -0.4, 1.1, 0.3, -0.6, -0.9, 0.2, 0.4, -1.3];
+        let mut q1 = q0.clone();
+        m.integrate_pos(&mut q1, &v, 0.5);
+        // The same rotations on the other sheet of the double cover.
+        for a in [3, 7] {
+            q1[a..a + 4].iter_mut().for_each(|x| *x = -*x);
+        }
+        let mut back = vec![0.0; m.nv];
+        m.differentiate_pos(&mut back, 0.5, &q0, &q1);
+        for (a, b) in back.iter().zip(&v) {
+            assert!((a - b).abs() < 1e-12, "{back:?} vs {v:?}");
+        }
+    }
 }

@@ -25,6 +25,9 @@ pub struct StepContext<'a> {
     /// Kinematics at `qpos`.
     pub data: &'a Data,
     pub qpos: &'a [f64],
+    /// Geoms held higher than the floor in this frame, with the height each keeps above it
+    /// (a swing foot's sole, [`crate::solver::Solver::set_raised_geoms`]), sorted by geom.
+    pub raised: &'a [(usize, f64)],
 }
 
 /// A hard constraint of the IK step.
@@ -71,8 +74,10 @@ impl Constraint for Ground {
     }
 
     fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
-        let top = self.floor + self.activation;
         for (&g, &radius) in self.geoms.iter().zip(&self.radius) {
+            let floor = self.floor
+                + ctx.raised.binary_search_by_key(&g, |r| r.0).map_or(0.0, |k| ctx.raised[k].1);
+            let top = floor + self.activation;
             // (The margin covers the rounding of the candidate points.)
             if ctx.data.geom_xpos[g].z - radius > top + 1e-9 {
                 continue;
@@ -84,7 +89,7 @@ impl Constraint for Ground {
                     continue;
                 }
                 // The z row of the point's Jacobian (zero off the body's dof chain).
-                let row = qp.add_row(self.floor - p.z);
+                let row = qp.add_row(floor - p.z);
                 for (d, column) in ctx.model.jac_point_columns(ctx.data, body, *p) {
                     row[d] = column.z;
                 }
@@ -368,7 +373,7 @@ mod tests {
         let mut data = Data::new(m);
         m.kinematics(q, &mut data);
         let mut qp = DenseQp::new(m.nv);
-        let ctx = StepContext { model: m, data: &data, qpos: q };
+        let ctx = StepContext { model: m, data: &data, qpos: q, raised: &[] };
         SelfCollision::new(m).add_rows(&ctx, &mut qp);
         (data, qp)
     }

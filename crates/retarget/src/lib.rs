@@ -68,6 +68,7 @@
 // Numeric modules allow indexing with the reason in their header.
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
+pub(crate) mod centroidal;
 pub mod chunked;
 pub mod config;
 pub mod constraints;
@@ -91,6 +92,7 @@ pub mod robot_names;
 pub mod robot_roles;
 pub mod shipped;
 pub mod smpl;
+pub mod solve;
 pub mod solver;
 pub mod targets;
 pub mod writers;

@@ -81,28 +81,6 @@ pub struct PlausibleOptions {
     pub speed_limits: SpeedLimits,
     /// Keep the robot's own geoms apart ([`crate::constraints::SelfCollision`]).
     pub self_collision: SelfCollisionMode,
-    /// Passes of the zero-phase `[1, 2, 1] / 4` filter over the solved trajectory at 30
-    /// frames/s, after which every frame is repaired (constraints and contacts held again)
-    /// with [`Solver::repair_frame`]; 0: no filtering. Other frame rates get
-    /// [`smoothing_passes_at`] passes, so that the filter spans the same time.
-    pub smoothing_passes: usize,
-    /// Filter the trajectory by `2S − S²` instead of `S` (`S`: the passes above), Tukey's
-    /// "twicing": flatter where the motion is and as strong where the jitter is
-    /// (`pipeline::smooth_trajectory`).
-    pub twicing: bool,
-    /// Robots whose legs ([`crate::feet::leg_length`]) are shorter than this (m) are
-    /// filtered over more passes: `smoothing_passes × (smoothing_leg / leg)²`, rounded, at
-    /// most [`MAX_SMOOTHING_SCALE`] times as many. The contact handling moves a foot by
-    /// centimetres within a frame or two (the swing clearance, the planted hold, the soles
-    /// kept apart), the same on every robot, and the shorter the leg, the larger the angles
-    /// that move it: lifting ToddlerBot's swing foot (legs of 0.28 m) clear of the floor in
-    /// one frame hiked its hip by 13° (its waist rolled 17–19° where GMR's solve rolls it
-    /// 4–5°), and its LAFAN1 walk's jitter was 9.6 rad/s² against `--gmr`'s 7.6 with two
-    /// passes. A step of angle `d / leg` filtered over a kernel of `σ` frames accelerates
-    /// the joint by `∫|q̈| ∝ d / (leg · σ)`: `σ ∝ 1 / leg` holds it, and the kernel's variance
-    /// is proportional to the passes. 0.55 m is just under the T1's legs (0.56 m), the
-    /// shortest the filter was tuned on; the G1 (0.69 m), N1, PM01 and H1 keep two passes.
-    pub smoothing_leg: f64,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
     /// [`reweigh`]) where the config pins the pelvis at a height that disagrees with the
     /// robot's legs (its position weight above [`PlausibleOptions::root_position_weight_cap`],
@@ -146,9 +124,9 @@ pub struct PlausibleOptions {
     /// targets that changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps,
     /// 504 frames of 7,184 with the margins and lead-in; 5 % more time).
     pub uncross_stuck: bool,
-    /// [`Solver::repair_frame`]'s weight and steps.
-    pub repair_weight: f64,
-    pub repair_steps: usize,
+    /// The trajectory solve over every frame ([`crate::solve::trajectory`]); 0 iterations:
+    /// the first pass alone.
+    pub trajectory: crate::solve::trajectory::TrajectoryOptions,
     /// [`SolverOptions::max_extra_steps`] of this solve (GMR: 10).
     pub max_extra_steps: usize,
 }
@@ -185,16 +163,12 @@ impl Default for PlausibleOptions {
             floor: 0.0,
             speed_limits: SpeedLimits::Robot,
             self_collision: SelfCollisionMode::On,
-            smoothing_passes: 2,
-            twicing: true,
-            smoothing_leg: 0.55,
             trunk_rotation_scale: 2.0,
             root_position_weight_cap: 20.0,
             pelvis_offset_range: [0.005, 0.015],
             both_ways: false,
             uncross_stuck: true,
-            repair_weight: 1000.0,
-            repair_steps: 1,
+            trajectory: crate::solve::trajectory::TrajectoryOptions::default(),
             max_extra_steps: 10,
         }
     }
@@ -209,9 +183,12 @@ impl PlausibleOptions {
     pub fn causal() -> PlausibleOptions {
         PlausibleOptions {
             planting: Planting::Off,
-            smoothing_passes: 0,
             both_ways: false,
             uncross_stuck: false,
+            trajectory: crate::solve::trajectory::TrajectoryOptions {
+                iterations: 0,
+                ..Default::default()
+            },
             ..PlausibleOptions::default()
         }
     }
@@ -271,10 +248,6 @@ pub struct ClipDiagnostics {
     /// and the share of [`reweigh`]'s changes applied (0 to 1).
     pub pelvis_offset: Option<f64>,
     pub reweigh_share: f64,
-    /// The robot's standing leg length (m, [`crate::feet::leg_length`]) and the smoothing
-    /// passes at 30 frames/s it gave ([`PlausibleOptions::smoothing_leg`]; default solve).
-    pub leg_length: Option<f64>,
-    pub smoothing_passes: usize,
     /// Frames of the crossed stances planned again uncrossed
     /// ([`PlausibleOptions::uncross_stuck`]), in order.
     pub uncrossed: Vec<Range<usize>>,
@@ -400,10 +373,6 @@ pub(crate) struct Prepared<'a> {
     /// [`ClipDiagnostics::pelvis_offset`] and [`ClipDiagnostics::reweigh_share`].
     pelvis_offset: Option<f64>,
     reweigh_share: f64,
-    /// The robot's standing leg length and the smoothing passes at 30 frames/s it gives
-    /// ([`PlausibleOptions::smoothing_leg`]; 0 in GMR's mode).
-    leg_length: Option<f64>,
-    smoothing_passes: usize,
 }
 
 /// Solved frames of a range.
@@ -457,8 +426,6 @@ impl<'a> Prepared<'a> {
             root_target: map.root,
             pelvis_offset: None,
             reweigh_share: 0.0,
-            leg_length: None,
-            smoothing_passes: 0,
         };
         // The source's contact phases are written in both modes (GMR's solve ignores them);
         // the default mode plants the feet on them.
@@ -472,15 +439,8 @@ impl<'a> Prepared<'a> {
             prepared.contacts = Some(crate::contact::detect(human, points, &contact));
         }
         if let SolveMode::Plausible(plausible) = &options.mode {
-            // The robot's feet: their legs' length sets the smoothing, and they are planted.
-            let feet = robot_feet(model, &prepared.stages);
-            prepared.leg_length = crate::feet::leg_length(model, &feet);
-            prepared.smoothing_passes = smoothing_passes_for_leg(
-                plausible.smoothing_passes,
-                plausible.smoothing_leg,
-                prepared.leg_length,
-            );
             if plausible.planting == Planting::On {
+                let feet = robot_feet(model, &prepared.stages);
                 prepared.plan_feet(plausible, feet);
                 if prepared.plan.is_some() {
                     prepared.reweigh(plausible)?;
@@ -755,18 +715,16 @@ impl<'a> Prepared<'a> {
         let mut solver = self.solver()?;
         let nq = self.model.nq;
         let first = range.start.saturating_sub(lead_in);
-        // The smoothing filter looks one frame ahead per pass (twice as far with twicing):
-        // solve that far past the range (when the clip goes on) so the range's last frames are
-        // filtered as in one pass.
-        let (passes, twicing) = match &self.options.mode {
-            SolveMode::Plausible(p) => {
-                (smoothing_passes_at(self.smoothing_passes, self.fps), p.twicing)
+        // The trajectory solve's last frames need the frames after them in view: a range
+        // that ends before the clip does is solved a window's overlap further (and the extra
+        // frames dropped), as a long clip's windows are.
+        let ahead = match &self.options.mode {
+            SolveMode::Plausible(p) if p.trajectory.iterations > 0 => {
+                crate::solve::trajectory::overlap_frames(&p.trajectory, self.fps)
             }
-            SolveMode::Gmr => (0, false),
+            _ => 0,
         };
-        let reach = if twicing { 2 * passes } else { passes };
-        let end = (range.end + reach).min(self.num_frames());
-        let dt = self.frame_dt();
+        let end = (range.end + ahead).min(self.num_frames());
         // Both passes hold every constraint. (A first pass under box bounds only is 1.4×
         // faster on the G1, but on robots whose tracking drives links into each other, e.g.
         // Toddy's hips, one repair step then cannot get out within the speed limits and drops
@@ -796,74 +754,51 @@ impl<'a> Prepared<'a> {
             forward(&mut solver)?
         };
         if let SolveMode::Plausible(p) = &self.options.mode {
-            if passes > 0 && !qpos.is_empty() {
-                let smooth = smooth_trajectory(self.model, &qpos, passes, twicing);
-                let ground = crate::constraints::collision_primitives(self.model);
-                let pairs = if p.self_collision == SelfCollisionMode::On {
-                    self.model.self_collision_pairs().pairs
-                } else {
-                    Vec::new()
-                };
-                let mut scratch = mjcf::Data::new(self.model);
-                // `keep`, not `set_qpos`: the repair's speed limits count from the frame before,
-                // and before the first there is none. (They counted from the first pass's last
-                // frame: the PM01's jumps began with its left hip pulled towards the end pose,
-                // twisted 164°.)
-                solver.keep(&smooth[..nq])?;
-                for (k, f) in (first..end).enumerate() {
-                    let reference = &smooth[k * nq..(k + 1) * nq];
-                    self.model.kinematics(reference, &mut scratch);
-                    self.set_frame_tasks_at(&mut solver, f, Some(&scratch))?;
-                    let relaxed =
-                        solver.repair_frame(reference, p.repair_weight, p.repair_steps, dt)?;
-                    reject_divergence(solver.qpos(), f)?;
-                    // The repair's rows are linearised at the smoothed pose; where its step
-                    // went far enough to leave a geom in the floor, it is checked.
-                    // (A short step stays where the rows describe it: nothing to check.)
-                    // (Also where the smoothing moved the pose far from the first pass: a
-                    // first pass that jumps between two frames, e.g. a foot passing the other,
-                    // smooths to a pose between them, which may be deep in the robot and too
-                    // deep for one repair step; and where the step had to relax rows.)
-                    let first_pass = &qpos[k * nq..(k + 1) * nq];
-                    let apart = |a: &[f64], b: &[f64]| {
-                        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
-                    };
-                    let far = apart(solver.qpos(), reference) > REPAIR_TRUSTED_STEP
-                        || apart(reference, first_pass) > REPAIR_TRUSTED_STEP
-                        || relaxed > 0;
-                    let mut depth = if far {
-                        violation(self.model, solver.data(), &ground, &pairs, p.floor)
-                    } else {
-                        0.0
-                    };
-                    // Then the least deep of the repaired pose, the first pass's and the
-                    // smoothed one. (The first pass may have relaxed its self-collision rows
-                    // where they and the speed limits could not hold together: the H1's hips
-                    // on the LAFAN1 walk, 1.65 cm deep, where the smoothed pose was clear and
-                    // the repair step from it went 1.7 cm in.)
-                    if depth > REPAIR_SLACK {
-                        for candidate in [first_pass, reference] {
-                            self.model.kinematics(candidate, &mut scratch);
-                            let d = violation(self.model, &scratch, &ground, &pairs, p.floor);
-                            if d < depth {
-                                solver.keep(candidate)?;
-                                depth = d;
-                            }
-                            if depth <= REPAIR_SLACK {
-                                break;
-                            }
-                        }
-                    }
-                    qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
-                    let (pos_error, rot_error) = solver.errors(self.frame_targets(f))?;
-                    (frames[k].pos_error, frames[k].rot_error) = (pos_error, rot_error);
-                }
+            if p.trajectory.iterations > 0 && !qpos.is_empty() {
+                self.solve_trajectory(&mut solver, &p.trajectory, first, &mut qpos, &mut frames)?;
             }
         }
         let skip = range.start - first;
         qpos.truncate((range.end - first) * nq);
         frames.truncate(range.end - first);
         Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
+    }
+
+    /// The trajectory solve ([`crate::solve::trajectory`]) of frames `first..` (`qpos`, the
+    /// first pass's, in and out), window after window.
+    fn solve_trajectory(
+        &self,
+        solver: &mut Solver<'a>,
+        options: &crate::solve::trajectory::TrajectoryOptions,
+        first: usize,
+        qpos: &mut [f64],
+        frames: &mut [FrameDiagnostics],
+    ) -> Result<(), Error> {
+        let nq = self.model.nq;
+        let n = frames.len();
+        let mut trajectory =
+            crate::solve::trajectory::Trajectory::new(solver, self.stages.len(), options, self.fps);
+        let (window, overlap) = trajectory.window_frames();
+        let mut start = 0;
+        let mut fixed: Vec<Vec<f64>> = Vec::new();
+        loop {
+            let stop = (start + window).min(n);
+            let part = &mut qpos[start * nq..stop * nq];
+            let diagnostics = trajectory.solve_window(self, first + start, &fixed, part)?;
+            for (k, d) in diagnostics.into_iter().enumerate() {
+                // (Which first pass a frame started from stays said.)
+                let backward = frames[start + k].backward;
+                frames[start + k] = FrameDiagnostics { backward, ..d };
+            }
+            if stop == n {
+                return Ok(());
+            }
+            let keep = stop - overlap;
+            fixed = (keep.saturating_sub(2)..keep)
+                .map(|t| qpos[t * nq..(t + 1) * nq].to_vec())
+                .collect();
+            start = keep;
+        }
     }
 
     /// Frame `f` of a first pass: its foot tasks set, solved from the previous frame's pose
@@ -937,6 +872,13 @@ impl<'a> Prepared<'a> {
         at: Option<&mjcf::Data>,
     ) -> Result<(), Error> {
         let Some((feet, plan)) = &self.plan else { return Ok(()) };
+        let raised: Vec<(usize, f64)> = feet
+            .iter()
+            .zip(&plan.swing_floor[f])
+            .filter_map(|(foot, floor)| Some((foot.as_ref()?, (*floor)?)))
+            .flat_map(|(foot, floor)| foot.geoms.iter().map(move |&g| (g, floor)))
+            .collect();
+        solver.set_raised_geoms(&raised);
         let mut points = Vec::with_capacity(8);
         let w = self.contact_weight();
         for (side, (foot, contact)) in feet.iter().zip(&plan.contact[f]).enumerate() {
@@ -1023,8 +965,6 @@ impl<'a> Prepared<'a> {
             solve_seconds,
             pelvis_offset: self.pelvis_offset,
             reweigh_share: self.reweigh_share,
-            leg_length: self.leg_length,
-            smoothing_passes: self.smoothing_passes,
             uncrossed: self.uncrossed.clone(),
         };
         (motion, diag)
@@ -1032,6 +972,22 @@ impl<'a> Prepared<'a> {
 
     pub(crate) fn num_frames(&self) -> usize {
         self.targets.len().checked_div(self.slots).unwrap_or(0)
+    }
+}
+
+impl crate::solve::trajectory::Frames for Prepared<'_> {
+    fn targets(&self, frame: usize) -> &[Pose] {
+        self.frame_targets(frame)
+    }
+
+    fn configure(&self, solver: &mut Solver<'_>, frame: usize) -> Result<(), Error> {
+        self.set_frame_tasks(solver, frame)
+    }
+
+    fn root_reference(&self, frame: usize) -> Option<(Pose, bool)> {
+        let free = self.model.joints.iter().find(|j| j.kind == JointType::Free)?;
+        let body = self.root_body()?;
+        Some((self.frame_targets(frame)[self.root_target], body == free.body))
     }
 }
 
@@ -1163,134 +1119,12 @@ pub(crate) fn start_pose(
     Some(q)
 }
 
-/// At most this many times [`PlausibleOptions::smoothing_passes`] for short legs
-/// ([`PlausibleOptions::smoothing_leg`]): legs of 0.19 m and longer are filtered as asked.
-pub const MAX_SMOOTHING_SCALE: f64 = 8.0;
-
-/// The smoothing passes at 30 frames/s for a robot whose legs are `leg` m long
-/// ([`PlausibleOptions::smoothing_leg`]): `passes`, times `(reference / leg)²` for legs
-/// shorter than `reference`.
-#[must_use]
-pub fn smoothing_passes_for_leg(passes: usize, reference: f64, leg: Option<f64>) -> usize {
-    let Some(leg) = leg.filter(|l| l.is_finite() && *l > 0.0) else { return passes };
-    let scale = (reference / leg).powi(2).clamp(1.0, MAX_SMOOTHING_SCALE);
-    (passes as f64 * scale).round() as usize
-}
-
-/// Passes of the `[1, 2, 1] / 4` filter at `fps` that smooth as much, in seconds, as
-/// `passes_at_30` passes at 30 frames/s: `n` passes are a kernel of variance `n / 2` frames²,
-/// so the count scales with `(fps / 30)²` (at least one when any is asked for). At 120 fps one
-/// pass per frame left the CMU walk's jitter at 69 rad/s² against GMR's 50; 16 passes: 32.
-#[must_use]
-pub fn smoothing_passes_at(passes_at_30: usize, fps: f64) -> usize {
-    if passes_at_30 == 0 || !fps.is_finite() || fps <= 0.0 {
-        return passes_at_30;
-    }
-    let scaled = passes_at_30 as f64 * (fps / 30.0).powi(2);
-    // (Beyond 240 fps the kernel would outgrow any lead-in; 64 passes is 240 fps's.)
-    (scaled.round() as usize).clamp(1, 64 * passes_at_30)
-}
-
-/// The trajectory `qpos` (`frames × nq`) filtered `passes` times by the zero-phase binomial
-/// kernel `[1, 2, 1] / 4` (end frames kept; quaternions renormalised): it damps the
-/// frame-to-frame jitter (the kernel cancels the highest frequency) without lag.
-///
-/// With `twicing`, the result is `2S − S²` of that filter `S`, clamped into the joints'
-/// ranges. Its gain at 30 frames/s with two passes, against one pass of `S` alone: 0.993
-/// against 0.957 at 2 Hz, where the arms swing on the LAFAN1 jumps; 0.81 against 0.75 at
-/// 5 Hz; 0.12 against 0.25 at 10 Hz. On the LAFAN1 jumps (G1, GMR's config, the default
-/// solve's other settings) the mean rotation error is 6.00° against 6.11° with one pass of
-/// `S` (`--gmr`: 5.52°). Any filter costs the arms some of it: GMR's solve follows the
-/// noise of the human's motion, whose jitter the filter removes (the G1's shoulders 0.6° from
-/// their targets unfiltered, 1.6° filtered, mean over the jumps).
-fn smooth_trajectory(model: &Model, qpos: &[f64], passes: usize, twicing: bool) -> Vec<f64> {
-    let nq = model.nq;
-    let frames = qpos.len() / nq.max(1);
-    let mut out = qpos.to_vec();
-    if frames < 3 {
-        return out;
-    }
-    let filter = |out: &mut Vec<f64>| {
-        let mut previous = out.clone();
-        for _ in 0..passes {
-            previous.copy_from_slice(out);
-            for t in 1..frames - 1 {
-                for i in 0..nq {
-                    let at = |u: usize| previous[u * nq + i];
-                    out[t * nq + i] = 0.25 * at(t - 1) + 0.5 * at(t) + 0.25 * at(t + 1);
-                }
-            }
-        }
-    };
-    filter(&mut out);
-    if twicing {
-        let mut twice = out.clone();
-        filter(&mut twice);
-        for (v, w) in out.iter_mut().zip(&twice) {
-            *v = 2.0 * *v - w;
-        }
-        // `2S − S²` is no average: it can overshoot a joint held at its range's end.
-        for joint in &model.joints {
-            let (JointType::Hinge | JointType::Slide, Some([lo, hi])) = (joint.kind, joint.range)
-            else {
-                continue;
-            };
-            for t in 0..frames {
-                let v = &mut out[t * nq + joint.qpos_adr];
-                *v = v.clamp(lo, hi);
-            }
-        }
-    }
-    for joint in &model.joints {
-        let Some(at) = joint.quat_adr() else { continue };
-        for t in 0..frames {
-            let q = &mut out[t * nq + at..t * nq + at + 4];
-            let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-            if n > 0.0 {
-                q.iter_mut().for_each(|v| *v /= n);
-            }
-        }
-    }
-    out
-}
-
 /// Windows of a clip solved to measure how far the pelvis stands from its target
 /// ([`Prepared::pelvis_offset`]), their length in frames, and the frames at the start of each
 /// left out (the solve settles from its start pose).
 const PELVIS_WINDOWS: usize = 3;
 const PELVIS_WINDOW: usize = 30;
 const PELVIS_SETTLE: usize = 5;
-
-/// How deep (m) a repaired frame may leave a collision geom in the floor or two in each
-/// other before the first pass's pose is kept instead (the report counts from 1 cm).
-const REPAIR_SLACK: f64 = 0.002;
-
-/// A repair step that moves no coordinate further than this (rad or m) from the smoothed pose,
-/// from a smoothed pose as close to the first pass's, is not checked: its linearised rows
-/// still describe where it ends (the first pass makes its rows again beyond the same
-/// distance), and it starts where the first pass held every constraint.
-const REPAIR_TRUSTED_STEP: f64 = 0.02;
-
-/// The deepest violation (m) in `data`: of the lowest of `geoms` below `floor`, and of any of
-/// `pairs` into each other; 0 when there is none.
-fn violation(
-    model: &Model,
-    data: &mjcf::Data,
-    geoms: &[usize],
-    pairs: &[[usize; 2]],
-    floor: f64,
-) -> f64 {
-    let ground = geoms
-        .iter()
-        .filter_map(|&g| mjcf::geom_lowest_point(model, data, g))
-        .map(|p| floor - p.z)
-        .fold(0.0, f64::max);
-    pairs
-        .iter()
-        .filter_map(|&[a, b]| mjcf::geom_distance(model, data, a, b, 0.0))
-        .map(|p| -p.distance)
-        .fold(ground, f64::max)
-}
 
 /// The robot's two feet (sole bodies, as the report finds them) with the task that moves
 /// each: a task on the sole body itself, else on its nearest ancestor that has one.
@@ -1524,7 +1358,7 @@ pub(crate) fn finite_pose(p: &Pose) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::{diverged, smoothing_passes_at, smoothing_passes_for_leg, splice_passes};
+    use super::{diverged, splice_passes};
     use crate::solver::FrameDiagnostics;
 
     /// One coordinate per frame, and the frames' errors.
@@ -1581,29 +1415,6 @@ mod tests {
         let (mut q, mut f) = (q0.clone(), f0.clone());
         assert!(splice_passes(1, (&[0], &[]), &mut q, &mut f, &b, &bf).is_empty());
         assert_eq!(q, vec![0.5; 4]);
-    }
-
-    #[test]
-    fn short_legs_are_smoothed_over_more_passes() {
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.69)), 2, "the G1's legs");
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.55)), 2);
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.28)), 8, "ToddlerBot's legs");
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.05)), 16, "bounded");
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, None), 2, "no feet found");
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(0.0)), 2);
-        assert_eq!(smoothing_passes_for_leg(2, 0.55, Some(f64::NAN)), 2);
-        assert_eq!(smoothing_passes_for_leg(0, 0.55, Some(0.28)), 0, "none asked for");
-    }
-
-    #[test]
-    fn the_smoothing_spans_the_same_time_at_any_frame_rate() {
-        assert_eq!(smoothing_passes_at(1, 30.0), 1);
-        assert_eq!(smoothing_passes_at(1, 60.0), 4);
-        assert_eq!(smoothing_passes_at(1, 120.0), 16);
-        assert_eq!(smoothing_passes_at(2, 120.0), 32);
-        assert_eq!(smoothing_passes_at(1, 24.0), 1, "never fewer than one");
-        assert_eq!(smoothing_passes_at(0, 120.0), 0, "none asked for, none done");
-        assert_eq!(smoothing_passes_at(1, 1000.0), 64, "bounded");
     }
 
     #[test]

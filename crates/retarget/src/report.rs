@@ -48,6 +48,10 @@
 //!   **penetrates** when its depth exceeds [`ReportOptions::penetration_tolerance`] (1 cm,
 //!   holosoma's `penetration_tolerance`, strict `>`); the **duration** is penetrating frames /
 //!   frames; the **max depth** is over all frames.
+//! - **Skating on the floor** (the robot's own contacts): per foot, over the frames whose
+//!   foot height `h` (above) is below [`ReportOptions::floor_height`] (1 cm), the share in
+//!   which the contact point (above, followed as a point of the foot) moves faster than
+//!   [`ReportOptions::skate_speed`] ([`FootReport::floor_skating_share`]).
 //! - **Skating** (needs the source's foot contacts): a foot's speed at frame t is
 //!   `|xy[t] − xy[t−1]| · fps` of its toe point ([`crate::feet::RobotFoot::toe_point`]: the
 //!   middle of the sole's front bottom edge; the body origin when the foot has no collision
@@ -156,7 +160,6 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 mod dynamics;
-mod nnls;
 mod rates;
 
 pub use dynamics::{CentreOfPressure, Dynamics, DynamicsOptions, Flight, FrameDynamics};
@@ -191,6 +194,9 @@ pub struct ReportOptions {
     /// A foot in source contact skates above this horizontal speed (m/s). Default 0.3
     /// (holosoma's strict threshold, 0.01 m per frame at 30 fps).
     pub skate_speed: f64,
+    /// A foot whose sole is lower than this (m) is on the floor for
+    /// [`FootReport::floor_skating_frames`]. Default 0.01 (the dynamics check's contact).
+    pub floor_height: f64,
     /// A foot in source contact floats above this height (m). Default 0.02.
     pub stance_float_height: f64,
     /// Foot heights (m) counted as resting on the ground in source contact. Default
@@ -224,6 +230,7 @@ impl Default for ReportOptions {
             limit_tolerance: 1e-6,
             penetration_tolerance: 0.01,
             skate_speed: 0.3,
+            floor_height: 0.01,
             stance_float_height: 0.02,
             sole_band: [-0.005, 0.01],
             self_collision_depth: 0.01,
@@ -299,6 +306,13 @@ pub struct FootReport {
     pub sliding_share: f64,
     pub slide_per_phase_cm_mean: f64,
     pub slide_per_phase_cm_max: f64,
+    /// Frames with the sole on the floor (lower than [`ReportOptions::floor_height`]), and
+    /// those of them in which its contact point moves faster than
+    /// [`ReportOptions::skate_speed`] (skating measured on the robot's own contacts, whatever
+    /// the source's), and their share.
+    pub floor_frames: usize,
+    pub floor_skating_frames: usize,
+    pub floor_skating_share: f64,
     /// Frames with the foot below the ground.
     pub penetration_frames: usize,
     pub penetration_cm_max: f64,
@@ -823,7 +837,12 @@ fn foot_report(
         t += 1;
     }
     let penetration: Vec<f64> = heights.iter().filter(|h| **h < 0.0).map(|h| -h * 100.0).collect();
+    let on_floor: Vec<usize> = (0..frames).filter(|&t| heights[t] < opts.floor_height).collect();
+    let floor_skating = on_floor.iter().filter(|&&t| speed[t] > opts.skate_speed).count();
     FootReport {
+        floor_frames: on_floor.len(),
+        floor_skating_frames: floor_skating,
+        floor_skating_share: ratio(floor_skating, on_floor.len()),
         body: model.bodies[foot].name.clone(),
         height_from: match from {
             HeightFrom::Geoms => "geoms",

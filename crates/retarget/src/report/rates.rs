@@ -14,7 +14,7 @@ use crate::writers::BodyPoses;
 
 /// Standard gravity (m/s²), the unit of [`RootAcceleration::threshold_mps2`] and of the
 /// dynamics check's m·g.
-pub const GRAVITY: f64 = 9.81;
+pub use crate::centroidal::GRAVITY;
 
 /// Acceleration of one trajectory of points: `|a|` over the interior frames.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

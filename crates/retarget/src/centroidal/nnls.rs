@@ -13,9 +13,9 @@
 #![allow(clippy::indexing_slicing)]
 
 /// Rows of every problem: a wrench (force, torque).
-pub(super) const ROWS: usize = 6;
+pub(crate) const ROWS: usize = 6;
 
-pub(super) type Column = [f64; ROWS];
+pub(crate) type Column = [f64; ROWS];
 
 fn dot(a: &Column, b: &Column) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -23,7 +23,7 @@ fn dot(a: &Column, b: &Column) -> f64 {
 
 /// Solves `min ‖Σ_j x_j cols[j] − b‖`, `x ≥ 0`; writes `x` (resized to the columns) and
 /// returns the residual `b − A x`.
-pub(super) fn nnls(cols: &[Column], b: &Column, x: &mut Vec<f64>) -> Column {
+pub(crate) fn nnls(cols: &[Column], b: &Column, x: &mut Vec<f64>) -> Column {
     let n = cols.len();
     x.clear();
     x.resize(n, 0.0);

@@ -1,0 +1,237 @@
+//! A symmetric positive definite system that is block-pentadiagonal in time: frame `t`'s
+//! unknowns (`n` of them, the robot's velocity coordinates) couple with those of frames
+//! `t ± 1` and `t ± 2` only (a second difference couples three frames), solved exactly by the
+//! block Cholesky factorisation `A = L Lᵀ`, `L` block lower-banded with the same bandwidth.
+//!
+//! ```text
+//! L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ
+//! L_{t,t−1} = (A_{t,t−1} − L_{t,t−2} L_{t−1,t−2}ᵀ) L_{t−1,t−1}⁻ᵀ
+//! L_{t,t}   = chol(A_{t,t} − L_{t,t−1} L_{t,t−1}ᵀ − L_{t,t−2} L_{t,t−2}ᵀ)
+//! ```
+//!
+//! The cost is `O(T n³)` (about 6 n³ flops a frame) and the storage three `n × n` blocks a
+//! frame; eliminating in time order creates no fill outside the band, where any other order
+//! fills the off-diagonal blocks of the whole clip (the tree's own sparsity inside a block is
+//! lost either way: the Schur complements couple every dof of a frame with every other).
+
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: blocks are `n × n` and vectors `T n`, sized in `Banded::new`; frame indices stay
+// below `T`.
+#![allow(clippy::indexing_slicing)]
+
+use nalgebra::{DMatrix, DVector};
+
+/// The system: per frame its diagonal block and its blocks towards the frame before and the
+/// one before that (`A_{t,t−1}`, `A_{t,t−2}`; zero for the first frames), and the right-hand
+/// side. Fill with [`Banded::add_diag`], [`Banded::add_coupling`] and `rhs`, then
+/// [`Banded::factor`] and [`Banded::solve`].
+#[derive(Debug, Clone)]
+pub struct Banded {
+    n: usize,
+    frames: usize,
+    /// `A_{t,t}` (symmetric; overwritten by `L_{t,t}` in [`Banded::factor`]).
+    diag: Vec<DMatrix<f64>>,
+    /// `A_{t,t−1}`, then `L_{t,t−1}`.
+    sub1: Vec<DMatrix<f64>>,
+    /// `A_{t,t−2}`, then `L_{t,t−2}`.
+    sub2: Vec<DMatrix<f64>>,
+    pub rhs: DVector<f64>,
+    scratch: DMatrix<f64>,
+}
+
+/// The factorisation met a block that is not positive definite (at this frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NotPositiveDefinite {
+    pub frame: usize,
+}
+
+impl Banded {
+    #[must_use]
+    pub fn new(n: usize, frames: usize) -> Banded {
+        let zeros = || vec![DMatrix::zeros(n, n); frames];
+        Banded {
+            n,
+            frames,
+            diag: zeros(),
+            sub1: zeros(),
+            sub2: zeros(),
+            rhs: DVector::zeros(n * frames),
+            scratch: DMatrix::zeros(n, n),
+        }
+    }
+
+    /// Unknowns per frame.
+    #[must_use]
+    pub fn block(&self) -> usize {
+        self.n
+    }
+
+    #[must_use]
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Sets every block and the right-hand side to zero (the next system of the same size).
+    pub fn clear(&mut self) {
+        for m in self.diag.iter_mut().chain(&mut self.sub1).chain(&mut self.sub2) {
+            m.fill(0.0);
+        }
+        self.rhs.fill(0.0);
+    }
+
+    /// `A_{t,t}`, to add a frame's own terms to (symmetric: both triangles are read).
+    pub fn diag_mut(&mut self, t: usize) -> &mut DMatrix<f64> {
+        &mut self.diag[t]
+    }
+
+    /// Adds `w` to entry `(i, j)` of the block coupling frame `t` with frame `t − lag`
+    /// (`lag` 0, 1 or 2; for lag 0 the caller keeps the block symmetric).
+    pub fn add(&mut self, t: usize, lag: usize, i: usize, j: usize, w: f64) {
+        let block = match lag {
+            0 => &mut self.diag[t],
+            1 => &mut self.sub1[t],
+            _ => &mut self.sub2[t],
+        };
+        block[(i, j)] += w;
+    }
+
+    /// The block coupling frame `t` with frame `t − lag` (`lag` 0, 1 or 2).
+    pub fn block_mut(&mut self, t: usize, lag: usize) -> &mut DMatrix<f64> {
+        match lag {
+            0 => &mut self.diag[t],
+            1 => &mut self.sub1[t],
+            _ => &mut self.sub2[t],
+        }
+    }
+
+    /// Frame `t`'s part of the right-hand side.
+    pub fn rhs_mut(&mut self, t: usize) -> nalgebra::DVectorViewMut<'_, f64> {
+        let n = self.n;
+        self.rhs.rows_mut(t * n, n)
+    }
+
+    /// Factorises in place. The blocks are overwritten; [`Banded::clear`] starts again.
+    pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
+        for t in 0..self.frames {
+            if t >= 2 {
+                // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ, i.e. L_{t−2,t−2} L_{t,t−2}ᵀ = A_{t,t−2}ᵀ.
+                self.scratch.copy_from(&self.sub2[t].transpose());
+                self.diag[t - 2].solve_lower_triangular_mut(&mut self.scratch);
+                self.sub2[t].copy_from(&self.scratch.transpose());
+                // A_{t,t−1} −= L_{t,t−2} L_{t−1,t−2}ᵀ
+                let (head, tail) = self.sub1.split_at_mut(t);
+                tail[0].gemm(-1.0, &self.sub2[t], &head[t - 1].transpose(), 1.0);
+            }
+            if t >= 1 {
+                self.scratch.copy_from(&self.sub1[t].transpose());
+                self.diag[t - 1].solve_lower_triangular_mut(&mut self.scratch);
+                self.sub1[t].copy_from(&self.scratch.transpose());
+            }
+            let (s1, s2) = (&self.sub1[t], &self.sub2[t]);
+            let d = &mut self.diag[t];
+            if t >= 1 {
+                d.gemm(-1.0, s1, &s1.transpose(), 1.0);
+            }
+            if t >= 2 {
+                d.gemm(-1.0, s2, &s2.transpose(), 1.0);
+            }
+            let chol = d.clone().cholesky().ok_or(NotPositiveDefinite { frame: t })?;
+            let mut l = chol.unpack();
+            // (`unpack` leaves the strict upper triangle at zero.)
+            std::mem::swap(d, &mut l);
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = rhs` with the factorisation; `rhs` becomes `x`.
+    pub fn solve(&mut self) {
+        let n = self.n;
+        let frames = self.frames;
+        // Forward: L y = b.
+        for t in 0..frames {
+            let mut b = self.rhs.rows(t * n, n).into_owned();
+            if t >= 1 {
+                b.gemv(-1.0, &self.sub1[t], &self.rhs.rows((t - 1) * n, n), 1.0);
+            }
+            if t >= 2 {
+                b.gemv(-1.0, &self.sub2[t], &self.rhs.rows((t - 2) * n, n), 1.0);
+            }
+            self.diag[t].solve_lower_triangular_mut(&mut b);
+            self.rhs.rows_mut(t * n, n).copy_from(&b);
+        }
+        // Backward: Lᵀ x = y.
+        for t in (0..frames).rev() {
+            let mut y = self.rhs.rows(t * n, n).into_owned();
+            if t + 1 < frames {
+                y.gemv_tr(-1.0, &self.sub1[t + 1], &self.rhs.rows((t + 1) * n, n), 1.0);
+            }
+            if t + 2 < frames {
+                y.gemv_tr(-1.0, &self.sub2[t + 2], &self.rhs.rows((t + 2) * n, n), 1.0);
+            }
+            self.diag[t].tr_solve_lower_triangular_mut(&mut y);
+            self.rhs.rows_mut(t * n, n).copy_from(&y);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random banded SPD system against a dense Cholesky solve of the same matrix.
+    #[test]
+    fn the_banded_solve_equals_the_dense_one() {
+        let (n, frames) = (5, 9);
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 33) as f64) / f64::from(1u32 << 31) - 0.5
+        };
+        let size = n * frames;
+        let mut dense = DMatrix::<f64>::zeros(size, size);
+        let mut banded = Banded::new(n, frames);
+        for t in 0..frames {
+            for lag in 0..=2.min(t) {
+                for i in 0..n {
+                    for j in 0..n {
+                        if lag == 0 && j > i {
+                            continue;
+                        }
+                        let v = rnd();
+                        let (r, c) = (t * n + i, (t - lag) * n + j);
+                        dense[(r, c)] += v;
+                        dense[(c, r)] += if r == c { 0.0 } else { v };
+                        banded.add(t, lag, i, j, v);
+                        if lag == 0 && i != j {
+                            banded.add(t, 0, j, i, v);
+                        }
+                    }
+                }
+            }
+        }
+        // Diagonally dominant: positive definite.
+        for t in 0..frames {
+            for i in 0..n {
+                dense[(t * n + i, t * n + i)] += 10.0;
+                banded.add(t, 0, i, i, 10.0);
+            }
+        }
+        let b = DVector::from_fn(size, |_, _| rnd());
+        banded.rhs.copy_from(&b);
+        banded.factor().unwrap();
+        banded.solve();
+        let x = dense.clone().cholesky().unwrap().solve(&b);
+        assert!((&banded.rhs - &x).amax() < 1e-12, "{}", (&banded.rhs - &x).amax());
+        assert!((dense * &banded.rhs - b).amax() < 1e-12);
+    }
+
+    #[test]
+    fn an_indefinite_block_is_reported_with_its_frame() {
+        let mut banded = Banded::new(2, 3);
+        for t in 0..3 {
+            banded.add(t, 0, 0, 0, 1.0);
+            banded.add(t, 0, 1, 1, if t == 1 { -1.0 } else { 1.0 });
+        }
+        assert_eq!(banded.factor(), Err(NotPositiveDefinite { frame: 1 }));
+    }
+}

@@ -1,0 +1,671 @@
+//! The trajectory solve: every frame of a window at once, so that no frame moves without its
+//! neighbours seeing it.
+//!
+//! Over frames `t` of a window, with the configuration `q_t` (tangent steps `δ_t`):
+//!
+//! ```text
+//! minimise  Σ_t  track_t(q_t)                       GMR's tasks (and the planted sole points)
+//!         + Σ_t  ½ Σ_i W_i (a_{t,i})²               a_t = (q_{t+1} ⊖ q_t) − (q_t ⊖ q_{t−1}), over dt²
+//! subject to     joint ranges, joint speeds |q_t ⊖ q_{t−1}| ≤ v dt,
+//!                every collision geom above the floor (a swing sole above its clearance),
+//!                the robot's geoms apart
+//! ```
+//!
+//! `W` weighs the acceleration of every velocity coordinate, the free root's translation and
+//! rotation included ([`TrajectoryOptions`]). Gauss–Newton: each iteration linearises the
+//! tasks at the current trajectory and solves the window's quadratic model in one piece, a
+//! block-pentadiagonal system ([`super::banded`]: a second difference couples three frames)
+//! in which the constraints that are active (within [`TrajectoryOptions::active_slack`] of
+//! their bound, or past it) are held by a stiff penalty
+//! ([`TrajectoryOptions::active_penalty`]); then one sweep over the frames solves each
+//! frame's subproblem exactly, its neighbours held, every constraint a hard row of the frame's
+//! QP ([`crate::Solver::trajectory_step`]). The sweep makes the result feasible and finds the
+//! constraints the next iteration holds; the banded step moves the whole window, which a
+//! sweep alone (block Gauss–Seidel in time) does only slowly where the smoothness outweighs
+//! the tracking: a step in the initial trajectory that it spreads over five frames is still
+//! at 40 % of its height after ten sweeps of a one-coordinate model.
+//!
+//! Long clips are solved in windows ([`TrajectoryOptions::window_s`]) that overlap by
+//! [`TrajectoryOptions::overlap_s`]: each window starts from the two frames before it as the
+//! previous window left them (held fixed), and keeps its frames up to its overlap, which the
+//! next window solves again with the frames after it in view.
+
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frame `k` of a window indexes `qpos` (`frames × nq`) and the banded system
+// (`frames` blocks of `nv`), both sized from the window here; dofs and qpos addresses come
+// from the model.
+#![allow(clippy::indexing_slicing)]
+
+use mjcf::{Data, JointType, Model};
+
+use super::banded::Banded;
+use super::dynamics::{Centroidal, DynamicsOptions, FrameState};
+use crate::lie::Pose;
+use crate::solver::{FrameDiagnostics, Solver};
+use crate::Error;
+
+/// Tunables of the trajectory solve.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct TrajectoryOptions {
+    /// Weight of the free root's linear acceleration, per (m/s²)²: an acceleration of
+    /// `sqrt(1 / w)` m/s² costs as much as one unit of the tracking objective.
+    pub root_translation: f64,
+    /// Weight of the free root's angular acceleration, per (rad/s²)².
+    pub root_rotation: f64,
+    /// Weight of every other coordinate's acceleration, per (rad/s²)² (or (m/s²)² for
+    /// slide joints), at least: see [`TrajectoryOptions::joint_cutoff_hz`].
+    pub joints: f64,
+    /// A joint's acceleration weight is its tracking stiffness `k` (the tracking objective's
+    /// curvature in that coordinate, averaged over the window) over `ω⁴`, `ω = 2π f` with
+    /// this `f` (Hz): the smoothness outweighs the tracking above `f` in every coordinate, a
+    /// wrist held by one light rotation task as much as a knee. (One weight for every joint
+    /// held the G1's wrists 9–10° off their targets on the LAFAN1 jumps, `--gmr` 1°.)
+    pub joint_cutoff_hz: f64,
+    /// Gauss–Newton iterations (a banded step and a sweep each).
+    pub iterations: usize,
+    /// Window length (s).
+    pub window_s: f64,
+    /// Frames at the end of a window solved again by the next window (s).
+    pub overlap_s: f64,
+    /// The banded step moves no coordinate further than this (rad, m): longer steps are
+    /// scaled down whole.
+    pub max_step: f64,
+    /// Penalty weight of a constraint held in the banded step.
+    pub active_penalty: f64,
+    /// A constraint within this of its bound (m, rad; joint speeds in rad per frame) is held
+    /// in the banded step.
+    pub active_slack: f64,
+    /// Which of the config's stages make the tracking objective (their tasks summed).
+    pub objective: Objective,
+    /// With [`Objective::AllStages`], the factor on the cost of every stage but the last.
+    pub earlier_stages: f64,
+    /// The dynamics term ([`super::dynamics`]).
+    pub dynamics: DynamicsOptions,
+}
+
+/// Which stages of the IK config the trajectory solve tracks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Objective {
+    /// The last stage's tasks: the one GMR's per-frame solve ends each frame with.
+    LastStage,
+    /// The tasks of every stage, summed.
+    AllStages,
+}
+
+impl Default for TrajectoryOptions {
+    fn default() -> Self {
+        TrajectoryOptions {
+            root_translation: 1.0,
+            root_rotation: 1e-2,
+            joints: 2e-5,
+            joint_cutoff_hz: 8.0,
+            iterations: 2,
+            window_s: 8.0,
+            overlap_s: 1.0,
+            max_step: 0.2,
+            active_penalty: 1e7,
+            active_slack: 1e-3,
+            objective: Objective::LastStage,
+            earlier_stages: 1.0,
+            dynamics: DynamicsOptions::default(),
+        }
+    }
+}
+
+/// What the trajectory solve needs to know of each frame beyond the solver's tasks: its
+/// targets, and how to set the solver up for it (weight factors, point tasks, raised geoms).
+pub(crate) trait Frames {
+    fn targets(&self, frame: usize) -> &[Pose];
+    fn configure(&self, solver: &mut Solver<'_>, frame: usize) -> Result<(), Error>;
+    /// The pose the human root's task follows in `frame` (its target), if there is one, and
+    /// whether that task is on the free root's body: the root's accelerations are measured
+    /// against this pose's (the rotation's only when the task is on the root's own body).
+    fn root_reference(&self, frame: usize) -> Option<(Pose, bool)>;
+}
+
+/// Per velocity coordinate, its acceleration weight (before `1 / dt⁴`).
+fn coordinate_weights(model: &Model, options: &TrajectoryOptions) -> Vec<f64> {
+    let mut w = vec![options.joints; model.nv];
+    for joint in &model.joints {
+        if joint.kind == JointType::Free {
+            let d = joint.dof_adr;
+            w[d..d + 3].fill(options.root_translation);
+            w[d + 3..d + 6].fill(options.root_rotation);
+        }
+    }
+    w
+}
+
+/// Frames per window and their overlap at `fps`.
+fn window_frames(options: &TrajectoryOptions, fps: f64) -> (usize, usize) {
+    let fps = if fps > 0.0 { fps } else { 30.0 };
+    let frames = |s: f64| (s * fps).round().max(1.0) as usize;
+    let window = frames(options.window_s).max(8);
+    (window, frames(options.overlap_s).min(window / 2))
+}
+
+/// The frames a window solves again after the ones it keeps, at `fps`: how far a range
+/// that ends before its clip does must be solved beyond its end.
+pub(crate) fn overlap_frames(options: &TrajectoryOptions, fps: f64) -> usize {
+    window_frames(options, fps).1
+}
+
+/// The stages the objective sums, with the factor on each one's cost.
+fn objective_stages(solver_stages: usize, options: &TrajectoryOptions) -> Vec<(usize, f64)> {
+    let last = solver_stages.checked_sub(1);
+    match options.objective {
+        Objective::LastStage => last.map(|s| (s, 1.0)).into_iter().collect(),
+        Objective::AllStages => (0..solver_stages)
+            .map(|s| (s, if Some(s) == last { 1.0 } else { options.earlier_stages }))
+            .collect(),
+    }
+}
+
+/// The reference accelerations of a sequence of `fixed + n` frames whose first variable frame
+/// is `first` (see [`Sequence::reference`]): the free root's, from [`Frames::root_reference`]
+/// (its translation's second difference in the world, its rotation's of the body-frame
+/// rotation vectors, as [`Model::differentiate_pos`] measures the root's), where the three
+/// frames around have one.
+fn reference_accelerations(
+    model: &Model,
+    frames: &dyn Frames,
+    first: usize,
+    fixed: usize,
+    n: usize,
+) -> Vec<f64> {
+    let nv = model.nv;
+    let len = fixed + n;
+    let mut out = vec![0.0; len * nv];
+    let Some(root) = model.joints.iter().find(|j| j.kind == JointType::Free) else { return out };
+    let d = root.dof_adr;
+    let pose = |j: usize| (first + j).checked_sub(fixed).and_then(|f| frames.root_reference(f));
+    let poses: Vec<Option<(Pose, bool)>> = (0..len).map(pose).collect();
+    let velocity = |a: &Pose, b: &Pose| {
+        let qa = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            a.quat[0], a.quat[1], a.quat[2], a.quat[3],
+        ));
+        let qb = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            b.quat[0], b.quat[1], b.quat[2], b.quat[3],
+        ));
+        (b.pos - a.pos, (qa.inverse() * qb).scaled_axis())
+    };
+    for t in 1..len.saturating_sub(1) {
+        let (Some((a, on_root)), Some((b, _)), Some((c, _))) =
+            (&poses[t - 1], &poses[t], &poses[t + 1])
+        else {
+            continue;
+        };
+        let ((p0, r0), (p1, r1)) = (velocity(a, b), velocity(b, c));
+        for i in 0..3 {
+            out[t * nv + d + i] = p1[i] - p0[i];
+            if *on_root {
+                out[t * nv + d + 3 + i] = r1[i] - r0[i];
+            }
+        }
+    }
+    out
+}
+
+/// A window's frames: `fixed` configurations before it (0 to 2, held), then the variables.
+struct Sequence<'a> {
+    nq: usize,
+    fixed: &'a [Vec<f64>],
+    qpos: &'a mut [f64],
+    /// Per frame of the sequence, the reference's acceleration in each velocity coordinate
+    /// (`len × nv`, zero where there is none): the smoothness costs the difference.
+    reference: Vec<f64>,
+}
+
+impl Sequence<'_> {
+    fn len(&self) -> usize {
+        self.fixed.len() + self.qpos.len() / self.nq
+    }
+
+    /// Configuration `j` of the whole sequence (fixed frames first).
+    fn at(&self, j: usize) -> &[f64] {
+        if j < self.fixed.len() {
+            &self.fixed[j]
+        } else {
+            let k = j - self.fixed.len();
+            &self.qpos[k * self.nq..(k + 1) * self.nq]
+        }
+    }
+}
+
+/// The trajectory solve of one clip's frames, with its solver (the default solve's: tasks,
+/// ground, self-collision, speed limits) and its work buffers.
+pub(crate) struct Trajectory<'s, 'm> {
+    solver: &'s mut Solver<'m>,
+    options: TrajectoryOptions,
+    stages: Vec<(usize, f64)>,
+    /// Per dof, `W_i / dt⁴`.
+    weight: Vec<f64>,
+    dt: f64,
+    banded: Banded,
+    /// The dynamics term, when on and the model's masses are known, and the states of the
+    /// sequence's frames it reads.
+    centroidal: Option<Centroidal>,
+    states: Vec<FrameState>,
+    scratch: Vec<f64>,
+}
+
+impl<'s, 'm> Trajectory<'s, 'm> {
+    pub(crate) fn new(
+        solver: &'s mut Solver<'m>,
+        stages: usize,
+        options: &TrajectoryOptions,
+        fps: f64,
+    ) -> Trajectory<'s, 'm> {
+        let model = solver.robot();
+        let dt = if fps > 0.0 { 1.0 / fps } else { 1.0 / 30.0 };
+        let weight = coordinate_weights(model, options).iter().map(|w| w / dt.powi(4)).collect();
+        Trajectory {
+            options: options.clone(),
+            stages: objective_stages(stages, options),
+            weight,
+            dt,
+            banded: Banded::new(model.nv, 0),
+            centroidal: Centroidal::new(model, &options.dynamics),
+            states: Vec::new(),
+            scratch: Vec::new(),
+            solver,
+        }
+    }
+
+    /// Frames per window and their overlap at this frame rate.
+    pub(crate) fn window_frames(&self) -> (usize, usize) {
+        window_frames(&self.options, 1.0 / self.dt)
+    }
+
+    /// Solves frames `first..first + n` (`qpos`: their configurations, `n × nq`, the initial
+    /// trajectory in, the solution out) with `fixed` (the 0 to 2 configurations before them)
+    /// held. Returns each frame's diagnostics.
+    pub(crate) fn solve_window(
+        &mut self,
+        frames: &dyn Frames,
+        first: usize,
+        fixed: &[Vec<f64>],
+        qpos: &mut [f64],
+    ) -> Result<Vec<FrameDiagnostics>, Error> {
+        let model = self.solver.robot();
+        let n = qpos.len() / model.nq.max(1);
+        if self.banded.frames() != n {
+            self.banded = Banded::new(model.nv, n);
+        }
+        let reference = reference_accelerations(model, frames, first, fixed.len(), n);
+        let mut seq = Sequence { nq: model.nq, fixed, qpos, reference };
+        self.joint_weights(frames, first, &seq)?;
+        let mut diagnostics = Vec::new();
+        for _ in 0..self.options.iterations {
+            self.banded_step(frames, first, &mut seq)?;
+            diagnostics = self.sweep(frames, first, &mut seq)?;
+        }
+        Ok(diagnostics)
+    }
+
+    /// The joints' acceleration weights of this window from their tracking stiffness at the
+    /// initial trajectory ([`TrajectoryOptions::joint_cutoff_hz`]).
+    fn joint_weights(
+        &mut self,
+        frames: &dyn Frames,
+        first: usize,
+        seq: &Sequence<'_>,
+    ) -> Result<(), Error> {
+        let model = self.solver.robot();
+        let (nq, nv) = (model.nq, model.nv);
+        let n = seq.qpos.len() / nq;
+        let mut k = vec![0.0; nv];
+        for f in 0..n {
+            self.solver.set_qpos(&seq.qpos[f * nq..(f + 1) * nq])?;
+            frames.configure(self.solver, first + f)?;
+            let d = self.solver.tracking_stiffness(&self.stages, frames.targets(first + f));
+            k.iter_mut().zip(&d).for_each(|(a, b)| *a += b / n as f64);
+        }
+        let omega4 = (std::f64::consts::TAU * self.options.joint_cutoff_hz).powi(4);
+        let free: Vec<usize> = model
+            .joints
+            .iter()
+            .filter(|j| j.kind == JointType::Free)
+            .flat_map(|j| j.dof_adr..j.dof_adr + 6)
+            .collect();
+        for (d, (w, k)) in self.weight.iter_mut().zip(&k).enumerate() {
+            if !free.contains(&d) {
+                *w = (k / omega4).max(self.options.joints) / self.dt.powi(4);
+            }
+        }
+        Ok(())
+    }
+
+    /// One Gauss–Newton step of the whole window: the banded system assembled at the current
+    /// trajectory, solved, and taken.
+    fn banded_step(
+        &mut self,
+        frames: &dyn Frames,
+        first: usize,
+        seq: &mut Sequence<'_>,
+    ) -> Result<(), Error> {
+        let model = self.solver.robot();
+        let (nq, nv) = (model.nq, model.nv);
+        let n = seq.qpos.len() / nq;
+        self.banded.clear();
+        self.fixed_states(seq);
+        for k in 0..n {
+            self.frame_terms(frames, first + k, k, &seq.qpos[k * nq..(k + 1) * nq])?;
+            self.record_state(seq.fixed.len() + k);
+        }
+        self.smoothness_terms(seq);
+        self.speed_terms(seq);
+        self.dynamics_terms(seq.fixed.len());
+        if self.banded.factor().is_err() {
+            return Err(Error::InvalidOption(
+                "the trajectory's quadratic model is not positive definite".to_owned(),
+            ));
+        }
+        self.banded.solve();
+        // A trust region: the whole step is scaled so that no coordinate moves further than
+        // `max_step` (a Gauss–Newton step from a poor linearisation, a limb's branch or a
+        // constraint far past its bound, must not throw a frame across the clip).
+        let largest = self.banded.rhs.amax();
+        if largest > self.options.max_step {
+            self.banded.rhs *= self.options.max_step / largest;
+        }
+        for k in 0..n {
+            let step = self.banded.rhs.rows(k * nv, nv);
+            let q = &mut seq.qpos[k * nq..(k + 1) * nq];
+            model.integrate_pos(q, step.as_slice(), 1.0);
+            // The joint ranges are a box: the step is projected onto it (the sweep's bounds
+            // only close 95 % of a gap, as GMR's do).
+            for joint in &model.joints {
+                if let (JointType::Hinge | JointType::Slide, Some([lo, hi])) =
+                    (joint.kind, joint.range)
+                {
+                    q[joint.qpos_adr] = q[joint.qpos_adr].clamp(lo, hi);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The dynamics term's states of the fixed frames (the solver's kinematics are moved).
+    fn fixed_states(&mut self, seq: &Sequence<'_>) {
+        let Some(centroidal) = &mut self.centroidal else { return };
+        let model = self.solver.robot();
+        self.states.resize(seq.len(), FrameState::default());
+        let mut data = Data::new(model);
+        for (j, q) in seq.fixed.iter().enumerate() {
+            model.kinematics(q, &mut data);
+            centroidal.state(model, &data, &mut self.states[j]);
+        }
+    }
+
+    /// The dynamics term's state of sequence frame `j` from the solver's kinematics.
+    fn record_state(&mut self, j: usize) {
+        let Some(centroidal) = &mut self.centroidal else { return };
+        let model = self.solver.robot();
+        if self.states.len() <= j {
+            self.states.resize(j + 1, FrameState::default());
+        }
+        centroidal.state(model, self.solver.data(), &mut self.states[j]);
+    }
+
+    /// `½ W d_t²` of every residual frame (`d`: the residual's length), linearised along
+    /// the residual, into the banded system.
+    fn dynamics_terms(&mut self, offset: usize) {
+        let Some(centroidal) = &self.centroidal else { return };
+        let w = centroidal.options.weight;
+        let supplies = centroidal.supplies(&self.states, self.dt);
+        let nv = self.solver.robot().nv;
+        let mut grads: [Vec<f64>; 3] = Default::default();
+        for (t, supply) in supplies.iter().enumerate() {
+            let Some(supply) = supply else { continue };
+            let mut d = None;
+            for (x, g) in grads.iter_mut().enumerate() {
+                d = centroidal.distance(
+                    &self.states,
+                    (t, x as isize - 1),
+                    supply,
+                    self.dt,
+                    (&mut self.scratch, g),
+                );
+            }
+            let Some(d) = d else { continue };
+            for x in 0..3 {
+                let Some(kx) = (t + x - 1).checked_sub(offset) else { continue };
+                let gx = &grads[x];
+                let mut rhs = self.banded.rhs_mut(kx);
+                for p in 0..nv {
+                    rhs[p] -= w * gx[p] * d;
+                }
+                for (y, gy) in grads.iter().enumerate().take(x + 1) {
+                    if (t + y - 1) < offset {
+                        continue;
+                    }
+                    let block = self.banded.block_mut(kx, x - y);
+                    for p in 0..nv {
+                        if gx[p] == 0.0 {
+                            continue;
+                        }
+                        for q in 0..nv {
+                            block[(p, q)] += w * gx[p] * gy[q];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Frame `frame`'s tracking model and its active constraints into block `k`.
+    fn frame_terms(
+        &mut self,
+        frames: &dyn Frames,
+        frame: usize,
+        k: usize,
+        q: &[f64],
+    ) -> Result<(), Error> {
+        let model = self.solver.robot();
+        let nv = model.nv;
+        self.solver.set_qpos(q)?;
+        frames.configure(self.solver, frame)?;
+        let (rho, slack) = (self.options.active_penalty, self.options.active_slack);
+        {
+            let (h, c) = self.solver.objective_model(&self.stages, frames.targets(frame));
+            let block = self.banded.diag_mut(k);
+            for i in 0..nv {
+                for j in i..nv {
+                    block[(i, j)] = h[i * nv + j];
+                    block[(j, i)] = h[i * nv + j];
+                }
+            }
+            let mut rhs = self.banded.rhs_mut(k);
+            for i in 0..nv {
+                rhs[i] = -c[i];
+            }
+        }
+        // Rows at or past their bound are held: a·δ = max(b, 0) (a point on the floor stays
+        // there, one below it comes up to it).
+        let rows: Vec<(Vec<f64>, f64)> = self
+            .solver
+            .constraint_rows()
+            .into_iter()
+            .filter(|(_, b)| *b > -slack)
+            .map(|(a, b)| (a.to_vec(), b.max(0.0)))
+            .collect();
+        for (a, b) in rows {
+            let nz: Vec<usize> = (0..nv).filter(|&d| a[d] != 0.0).collect();
+            let block = self.banded.diag_mut(k);
+            for &i in &nz {
+                for &j in &nz {
+                    block[(i, j)] += rho * a[i] * a[j];
+                }
+            }
+            let mut rhs = self.banded.rhs_mut(k);
+            for &i in &nz {
+                rhs[i] += rho * a[i] * b;
+            }
+        }
+        // Joints at a range end stay there.
+        for joint in &model.joints {
+            let (JointType::Hinge | JointType::Slide, Some([lo, hi])) = (joint.kind, joint.range)
+            else {
+                continue;
+            };
+            let v = q[joint.qpos_adr];
+            if v - lo < slack || hi - v < slack {
+                self.banded.add(k, 0, joint.dof_adr, joint.dof_adr, rho);
+            }
+        }
+        Ok(())
+    }
+
+    /// `½ Σ W_i a_{t,i}²` over the sequence's interior frames, linearised
+    /// (`a_t(δ) = a_t + δ_{t+1} − 2 δ_t + δ_{t−1}`, fixed frames' δ zero).
+    fn smoothness_terms(&mut self, seq: &Sequence<'_>) {
+        let model = self.solver.robot();
+        let nv = model.nv;
+        let len = seq.len();
+        let offset = seq.fixed.len();
+        let velocities = self.velocities(seq);
+        const COEF: [f64; 3] = [1.0, -2.0, 1.0];
+        for t in 1..len.saturating_sub(1) {
+            // v_{t+1} − v_t: velocities[j] is q_j ⊖ q_{j−1} (j ≥ 1).
+            let (v0, v1) = (&velocities[(t - 1) * nv..t * nv], &velocities[t * nv..(t + 1) * nv]);
+            let aref = &seq.reference[t * nv..(t + 1) * nv];
+            for (x, &cx) in COEF.iter().enumerate() {
+                let Some(kx) = (t + x - 1).checked_sub(offset) else { continue };
+                for i in 0..nv {
+                    let w = self.weight[i];
+                    let a = v1[i] - v0[i] - aref[i];
+                    self.banded.rhs_mut(kx)[i] -= w * cx * a;
+                }
+                for (y, &cy) in COEF.iter().enumerate().take(x + 1) {
+                    if (t + y - 1) < offset {
+                        continue;
+                    }
+                    for i in 0..nv {
+                        self.banded.add(kx, x - y, i, i, self.weight[i] * cx * cy);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Per consecutive pair of the sequence, `q_j ⊖ q_{j−1}` (`(len − 1) × nv`).
+    fn velocities(&self, seq: &Sequence<'_>) -> Vec<f64> {
+        let model = self.solver.robot();
+        let nv = model.nv;
+        let len = seq.len();
+        let mut out = vec![0.0; len.saturating_sub(1) * nv];
+        for j in 1..len {
+            model.differentiate_pos(&mut out[(j - 1) * nv..j * nv], 1.0, seq.at(j - 1), seq.at(j));
+        }
+        out
+    }
+
+    /// Joint speeds at their limit between two frames stay there in the banded step.
+    fn speed_terms(&mut self, seq: &Sequence<'_>) {
+        let model = self.solver.robot();
+        let nv = model.nv;
+        let offset = seq.fixed.len();
+        let rho = self.options.active_penalty;
+        let velocities = self.velocities(seq);
+        let limits: Vec<(usize, f64)> = self
+            .solver
+            .dof_speed_limits()
+            .iter()
+            .enumerate()
+            .filter_map(|(d, v)| v.map(|v| (d, v * self.dt)))
+            .collect();
+        for j in 1..seq.len() {
+            let Some(k) = j.checked_sub(offset) else { continue };
+            for &(d, reach) in &limits {
+                if velocities[(j - 1) * nv + d].abs() < reach - self.options.active_slack {
+                    continue;
+                }
+                self.banded.add(k, 0, d, d, rho);
+                if k >= 1 {
+                    self.banded.add(k - 1, 0, d, d, rho);
+                    self.banded.add(k, 1, d, d, -rho);
+                }
+            }
+        }
+    }
+
+    /// One forward sweep: each frame's subproblem solved exactly (one constrained step), its
+    /// neighbours held: the smoothness terms that involve the frame are a pull of its step
+    /// towards the one that minimises them, and the dynamics terms a quadratic of their own
+    /// ([`Solver::set_extra`]).
+    fn sweep(
+        &mut self,
+        frames: &dyn Frames,
+        first: usize,
+        seq: &mut Sequence<'_>,
+    ) -> Result<Vec<FrameDiagnostics>, Error> {
+        let model = self.solver.robot();
+        let (nq, nv) = (model.nq, model.nv);
+        let offset = seq.fixed.len();
+        let len = seq.len();
+        let n = len - offset;
+        let mut diagnostics = Vec::with_capacity(n);
+        let mut weights = vec![0.0; nv];
+        let mut target = vec![0.0; nv];
+        for k in 0..n {
+            let j = k + offset;
+            // Tangents at q_j towards each neighbour within two frames.
+            let mut u: [Option<Vec<f64>>; 5] = Default::default();
+            for (slot, dj) in (-2isize..=2).enumerate() {
+                if dj == 0 {
+                    continue;
+                }
+                let Some(i) = j.checked_add_signed(dj).filter(|&i| i < len) else { continue };
+                let mut v = vec![0.0; nv];
+                model.differentiate_pos(&mut v, 1.0, seq.at(j), seq.at(i));
+                u[slot] = Some(v);
+            }
+            // a_t for t = j−1, j, j+1 (needs t−1 and t+1): c_j x + s_t.
+            weights.fill(0.0);
+            target.fill(0.0);
+            for t in [j.wrapping_sub(1), j, j + 1] {
+                if t == usize::MAX || t == 0 || t + 1 >= len {
+                    continue;
+                }
+                let c_self = if t == j { -2.0 } else { 1.0 };
+                for i in 0..nv {
+                    let mut s = -seq.reference[t * nv + i];
+                    for (x, cx) in [(t - 1, 1.0), (t, -2.0), (t + 1, 1.0)] {
+                        if x == j {
+                            continue;
+                        }
+                        let slot = x + 2 - j;
+                        s += cx * u[slot].as_ref().map_or(0.0, |v| v[i]);
+                    }
+                    weights[i] += self.weight[i] * c_self * c_self;
+                    target[i] -= self.weight[i] * c_self * s;
+                }
+            }
+            // The smoothness's ½ w (x − r)² per dof: w on the diagonal, −w r (here `target`
+            // holds −w r) into c.
+            let mut extra_h = vec![0.0; nv * nv];
+            for i in 0..nv {
+                extra_h[i * nv + i] = weights[i];
+            }
+            let extra_c: Vec<f64> = target.iter().map(|t| -t).collect();
+            let q = seq.at(j).to_vec();
+            self.solver.set_qpos(&q)?;
+            frames.configure(self.solver, first + k)?;
+            self.solver.set_extra(&extra_h, &extra_c)?;
+            let previous = if j >= 1 { seq.at(j - 1).to_vec() } else { q.clone() };
+            self.solver.set_previous(&previous)?;
+            let next = (j + 1 < len).then(|| seq.at(j + 1).to_vec());
+            self.solver.set_next(next.as_deref())?;
+            let dt = if j >= 1 { self.dt } else { 0.0 };
+            let (relaxed, _) =
+                self.solver.trajectory_step(&self.stages, frames.targets(first + k), dt)?;
+            seq.qpos[k * nq..(k + 1) * nq].copy_from_slice(self.solver.qpos());
+            diagnostics.push(self.solver.diagnostics(frames.targets(first + k), relaxed)?);
+        }
+        self.solver.set_extra(&[], &[])?;
+        self.solver.set_next(None)?;
+        Ok(diagnostics)
+    }
+}
