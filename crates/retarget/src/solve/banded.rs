@@ -36,6 +36,8 @@ pub struct Banded {
     /// `A_{t,t−2}`, then `L_{t,t−2}`.
     sub2: Vec<DMatrix<f64>>,
     pub rhs: DVector<f64>,
+    /// `L_{t,t}⁻¹` per frame ([`Banded::factor`]).
+    inverse: Vec<DMatrix<f64>>,
     scratch: DMatrix<f64>,
 }
 
@@ -56,6 +58,7 @@ impl Banded {
             sub1: zeros(),
             sub2: zeros(),
             rhs: DVector::zeros(n * frames),
+            inverse: zeros(),
             scratch: DMatrix::zeros(n, n),
         }
     }
@@ -111,21 +114,21 @@ impl Banded {
     }
 
     /// Factorises in place. The blocks are overwritten; [`Banded::clear`] starts again.
+    /// (The off-diagonal blocks are formed with the diagonal factors' inverses, products
+    /// that run at matrix-multiply speed, where triangular solves by columns do not.)
     pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
         for t in 0..self.frames {
             if t >= 2 {
-                // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ, i.e. L_{t−2,t−2} L_{t,t−2}ᵀ = A_{t,t−2}ᵀ.
-                self.scratch.copy_from(&self.sub2[t].transpose());
-                self.diag[t - 2].solve_lower_triangular_mut(&mut self.scratch);
-                self.sub2[t].copy_from(&self.scratch.transpose());
+                // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ
+                self.scratch.gemm(1.0, &self.sub2[t], &self.inverse[t - 2].transpose(), 0.0);
+                self.sub2[t].copy_from(&self.scratch);
                 // A_{t,t−1} −= L_{t,t−2} L_{t−1,t−2}ᵀ
                 let (head, tail) = self.sub1.split_at_mut(t);
                 tail[0].gemm(-1.0, &self.sub2[t], &head[t - 1].transpose(), 1.0);
             }
             if t >= 1 {
-                self.scratch.copy_from(&self.sub1[t].transpose());
-                self.diag[t - 1].solve_lower_triangular_mut(&mut self.scratch);
-                self.sub1[t].copy_from(&self.scratch.transpose());
+                self.scratch.gemm(1.0, &self.sub1[t], &self.inverse[t - 1].transpose(), 0.0);
+                self.sub1[t].copy_from(&self.scratch);
             }
             let (s1, s2) = (&self.sub1[t], &self.sub2[t]);
             let d = &mut self.diag[t];
@@ -135,10 +138,8 @@ impl Banded {
             if t >= 2 {
                 d.gemm(-1.0, s2, &s2.transpose(), 1.0);
             }
-            let chol = d.clone().cholesky().ok_or(NotPositiveDefinite { frame: t })?;
-            let mut l = chol.unpack();
-            // (`unpack` leaves the strict upper triangle at zero.)
-            std::mem::swap(d, &mut l);
+            cholesky_in_place(d).map_err(|()| NotPositiveDefinite { frame: t })?;
+            lower_inverse(d, &mut self.inverse[t]);
         }
         Ok(())
     }
@@ -147,29 +148,75 @@ impl Banded {
     pub fn solve(&mut self) {
         let n = self.n;
         let frames = self.frames;
+        let mut b = DVector::zeros(n);
+        let mut y = DVector::zeros(n);
         // Forward: L y = b.
         for t in 0..frames {
-            let mut b = self.rhs.rows(t * n, n).into_owned();
+            b.copy_from(&self.rhs.rows(t * n, n));
             if t >= 1 {
                 b.gemv(-1.0, &self.sub1[t], &self.rhs.rows((t - 1) * n, n), 1.0);
             }
             if t >= 2 {
                 b.gemv(-1.0, &self.sub2[t], &self.rhs.rows((t - 2) * n, n), 1.0);
             }
-            self.diag[t].solve_lower_triangular_mut(&mut b);
-            self.rhs.rows_mut(t * n, n).copy_from(&b);
+            y.gemv(1.0, &self.inverse[t], &b, 0.0);
+            self.rhs.rows_mut(t * n, n).copy_from(&y);
         }
         // Backward: Lᵀ x = y.
         for t in (0..frames).rev() {
-            let mut y = self.rhs.rows(t * n, n).into_owned();
+            b.copy_from(&self.rhs.rows(t * n, n));
             if t + 1 < frames {
-                y.gemv_tr(-1.0, &self.sub1[t + 1], &self.rhs.rows((t + 1) * n, n), 1.0);
+                b.gemv_tr(-1.0, &self.sub1[t + 1], &self.rhs.rows((t + 1) * n, n), 1.0);
             }
             if t + 2 < frames {
-                y.gemv_tr(-1.0, &self.sub2[t + 2], &self.rhs.rows((t + 2) * n, n), 1.0);
+                b.gemv_tr(-1.0, &self.sub2[t + 2], &self.rhs.rows((t + 2) * n, n), 1.0);
             }
-            self.diag[t].tr_solve_lower_triangular_mut(&mut y);
+            y.gemv_tr(1.0, &self.inverse[t], &b, 0.0);
             self.rhs.rows_mut(t * n, n).copy_from(&y);
+        }
+    }
+}
+
+/// The Cholesky factor of the symmetric `a` (its lower triangle read) in place: `a = L Lᵀ`,
+/// the strict upper triangle set to zero. `Err` where a pivot is not positive.
+fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), ()> {
+    let n = a.nrows();
+    for j in 0..n {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if d.is_nan() || d <= 0.0 || d.is_infinite() {
+            return Err(());
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..n {
+            let mut v = a[(i, j)];
+            for k in 0..j {
+                v -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = v / d;
+        }
+        for i in 0..j {
+            a[(i, j)] = 0.0;
+        }
+    }
+    Ok(())
+}
+
+/// `out = l⁻¹` for the lower-triangular `l` (non-zero diagonal), by columns.
+fn lower_inverse(l: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    let n = l.nrows();
+    out.fill(0.0);
+    for j in 0..n {
+        out[(j, j)] = 1.0 / l[(j, j)];
+        for i in j + 1..n {
+            let mut v = 0.0;
+            for k in j..i {
+                v -= l[(i, k)] * out[(k, j)];
+            }
+            out[(i, j)] = v / l[(i, i)];
         }
     }
 }

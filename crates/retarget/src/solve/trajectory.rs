@@ -37,6 +37,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use mjcf::{Data, JointType, Model};
+use nalgebra::DVectorView;
 
 use super::banded::Banded;
 use super::dynamics::{Centroidal, DynamicsOptions, FrameState};
@@ -103,7 +104,7 @@ impl Default for TrajectoryOptions {
             iterations: 2,
             window_s: 8.0,
             overlap_s: 1.0,
-            max_step: 0.2,
+            max_step: 0.5,
             active_penalty: 1e7,
             active_slack: 1e-3,
             objective: Objective::LastStage,
@@ -136,6 +137,9 @@ fn coordinate_weights(model: &Model, options: &TrajectoryOptions) -> Vec<f64> {
     }
     w
 }
+
+/// The joints' tracking stiffness is averaged over every this many frames of a window.
+const STIFFNESS_STRIDE: usize = 4;
 
 /// Frames per window and their overlap at `fps`.
 fn window_frames(options: &TrajectoryOptions, fps: f64) -> (usize, usize) {
@@ -316,11 +320,13 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let (nq, nv) = (model.nq, model.nv);
         let n = seq.qpos.len() / nq;
         let mut k = vec![0.0; nv];
-        for f in 0..n {
+        // (A mean over every `STIFFNESS_STRIDE`-th frame: it changes slowly.)
+        let sampled: Vec<usize> = (0..n).step_by(STIFFNESS_STRIDE).collect();
+        for &f in &sampled {
             self.solver.set_qpos(&seq.qpos[f * nq..(f + 1) * nq])?;
             frames.configure(self.solver, first + f)?;
             let d = self.solver.tracking_stiffness(&self.stages, frames.targets(first + f));
-            k.iter_mut().zip(&d).for_each(|(a, b)| *a += b / n as f64);
+            k.iter_mut().zip(&d).for_each(|(a, b)| *a += b / sampled.len() as f64);
         }
         let omega4 = (std::f64::consts::TAU * self.options.joint_cutoff_hz).powi(4);
         let free: Vec<usize> = model
@@ -442,14 +448,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                         continue;
                     }
                     let block = self.banded.block_mut(kx, x - y);
-                    for p in 0..nv {
-                        if gx[p] == 0.0 {
-                            continue;
-                        }
-                        for q in 0..nv {
-                            block[(p, q)] += w * gx[p] * gy[q];
-                        }
-                    }
+                    let (gx, gy) =
+                        (DVectorView::from_slice(gx, nv), DVectorView::from_slice(gy, nv));
+                    block.ger(w, &gx, &gy, 1.0);
                 }
             }
         }
