@@ -555,6 +555,38 @@ pub(crate) fn run(
     (positions, orientations)
 }
 
+/// NaN or infinity anywhere in the motion is an error naming the first one.
+pub(crate) fn check_finite(bvh: &Bvh) -> Result<(), Error> {
+    let motion = &bvh.motion;
+    let Some(at) = motion.values.iter().position(|v| !v.is_finite()) else {
+        return Ok(());
+    };
+    let (frame, column) = (at / motion.num_channels, at % motion.num_channels);
+    let joint = bvh
+        .skeleton
+        .joints
+        .iter()
+        .find(|j| (j.first_channel..j.first_channel + j.channels.len()).contains(&column));
+    Err(Error::NonFinite {
+        frame,
+        joint: joint.map(|j| j.name.clone()).unwrap_or_default(),
+        channel: joint
+            .and_then(|j| j.channels.get(column - j.first_channel))
+            .map(|c| c.name().to_owned())
+            .unwrap_or_default(),
+        value: motion.values.get(at).copied().unwrap_or(f64::NAN),
+    })
+}
+
+/// World positions of the rest pose (all channels zero, OFFSETs only), metres.
+pub(crate) fn rest_pose(plan: &Plan, world: &ToWorld) -> Vec<Vector3<f64>> {
+    let n = plan.num_joints();
+    let mut q = vec![math::IDENTITY; n];
+    let mut p = vec![[0.0; 3]; n];
+    plan.rest(&mut q, &mut p);
+    p.iter().map(|&x| world.position(x)).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -31,10 +31,14 @@ pub mod conventions;
 mod error;
 mod forward;
 pub mod frames;
+mod humanoid;
+mod limits;
 pub mod markers;
 mod math;
 mod motion;
 mod options;
+mod posture;
+mod recogniser;
 mod roles;
 mod size;
 mod straight;
@@ -44,19 +48,18 @@ mod trig;
 pub use error::Error;
 pub use forward::{PositionChannels, PositionReading};
 pub use frames::canonical_frames;
-pub use motion::{HumanMotion, MAX_DISTANCE, MAX_STEP};
+pub use humanoid::{Humanoid, Reference, RestPose, RoleJoint, RoleMap, Rule, UpAxis};
+pub use limits::{MAX_DISTANCE, MAX_STEP};
+pub use motion::HumanMotion;
 pub use options::{AxisConvention, DerivedBody, FkOptions, UnitChoice};
-pub use roles::{
-    Humanoid, Part, Reference, RestPose, Role, RoleJoint, RoleMap, Rule, Side, UpAxis,
-};
+pub use recogniser::{recognise, recognise_posed, PosedFrame};
+pub use roles::{Part, Role, Side};
 pub use straight::straighten_limbs;
 
-use std::collections::BTreeMap;
-
 use bvh::Bvh;
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
-use forward::{Plan, ToWorld};
+use forward::{check_finite, rest_pose, Plan, ToWorld};
 use size::Landmarks;
 
 /// What [`human_motion`] decided and measured, for reports and for the retargeter.
@@ -111,76 +114,6 @@ impl FkReport {
     }
 }
 
-/// Recognise the humanoid in `bvh`: which joint plays each [`Role`] and by which rule, the
-/// up axis, the rest-pose kind and the body frames ([`Humanoid`]). `given` fixes roles by
-/// joint name. An unrecognised skeleton is an [`Error::Unrecognised`] that lists the missing
-/// roles and names that would be recognised.
-pub fn recognise(bvh: &Bvh, given: &BTreeMap<Role, String>) -> Result<Humanoid, Error> {
-    let plan = Plan::new(bvh)?;
-    check_finite(bvh)?;
-    roles::recognise(&bvh.skeleton, &samples(&plan, bvh), given)
-}
-
-/// One sampled frame for [`recognise_posed`]: its index in the clip, then every joint's
-/// position and orientation (in skeleton order).
-pub type PosedFrame = (usize, Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
-
-/// [`recognise`] for a skeleton whose poses come from another forward kinematics (SMPL body
-/// models: crate `smpl`): its hierarchy, names and OFFSETs, its joints' positions in the
-/// zero pose (`rest`, every orientation the identity there) and a few frames of its motion
-/// (`frames`; up to 128 evenly spaced ones are enough), all in one set of axes and units.
-pub fn recognise_posed(
-    skeleton: &bvh::Skeleton,
-    rest: Vec<Vector3<f64>>,
-    frames: Vec<PosedFrame>,
-    given: &BTreeMap<Role, String>,
-) -> Result<Humanoid, Error> {
-    // The hierarchy's checks (a tree in parents-first order, finite OFFSETs).
-    Plan::new(&Bvh { skeleton: skeleton.clone(), motion: bvh::Motion::default() })?;
-    let n = skeleton.joints.len();
-    let bad = std::iter::once((rest.len(), n))
-        .chain(frames.iter().map(|(_, p, q)| (p.len(), q.len())))
-        .find(|&(p, q)| p != n || q != n);
-    if let Some((positions, orientations)) = bad {
-        return Err(Error::BodyShape { positions, orientations, num_frames: 1, num_bodies: n });
-    }
-    roles::recognise(skeleton, &roles::Samples { rest, frames }, given)
-}
-
-/// At most this many frames of a clip are looked at to recognise the humanoid.
-const SAMPLED_FRAMES: usize = 128;
-
-/// The zero pose and evenly spaced frames, in file axes and units.
-fn samples(plan: &Plan, bvh: &Bvh) -> roles::Samples {
-    let file = ToWorld::new(&AxisConvention::ZUp, 1.0);
-    let n = bvh.motion.num_frames;
-    let count = n.min(SAMPLED_FRAMES);
-    let picked: Vec<usize> =
-        (0..count).map(|k| if count > 1 { k * (n - 1) / (count - 1) } else { 0 }).collect();
-    let motion = &bvh.motion;
-    let sub = Bvh {
-        skeleton: bvh.skeleton.clone(),
-        motion: bvh::Motion {
-            frame_time: motion.frame_time,
-            num_frames: picked.len(),
-            num_channels: motion.num_channels,
-            values: picked.iter().flat_map(|&f| motion.frame(f).iter().copied()).collect(),
-        },
-    };
-    let (positions, orientations) = forward::run(plan, &sub, &file, &[]);
-    let joints = plan.num_joints();
-    let frames = picked
-        .iter()
-        .enumerate()
-        .map(|(k, &f)| {
-            let range = k * joints..(k + 1) * joints;
-            let p = positions.get(range.clone()).unwrap_or_default();
-            (f, p.to_vec(), orientations.get(range).unwrap_or_default().to_vec())
-        })
-        .collect();
-    roles::Samples { rest: rest_pose(plan, &file), frames }
-}
-
 /// The body names [`human_motion`] gives `bvh` with `options` (joints, End Sites, derived
 /// bodies), without running the forward kinematics.
 pub fn body_names(bvh: &Bvh, options: &FkOptions) -> Result<Vec<String>, Error> {
@@ -201,7 +134,8 @@ pub fn human_motion(bvh: &Bvh, options: &FkOptions) -> Result<(HumanMotion, FkRe
     check_finite(bvh)?;
     let joint_names: Vec<String> = bvh.skeleton.joints.iter().map(|j| j.name.clone()).collect();
     let derived = resolve_derived(&joint_names, &options.derived)?;
-    let humanoid = match roles::recognise(&bvh.skeleton, &samples(&plan, bvh), &options.roles) {
+    let samples = recogniser::samples(&plan, bvh);
+    let humanoid = match recogniser::from_samples(&bvh.skeleton, &samples, &options.roles) {
         Err(e @ Error::UnknownRoleJoint { .. }) => return Err(e),
         other => other,
     };
@@ -277,29 +211,6 @@ fn positive(name: &'static str, value: f64) -> Result<f64, Error> {
     }
 }
 
-/// NaN or infinity anywhere in the motion is an error naming the first one.
-fn check_finite(bvh: &Bvh) -> Result<(), Error> {
-    let motion = &bvh.motion;
-    let Some(at) = motion.values.iter().position(|v| !v.is_finite()) else {
-        return Ok(());
-    };
-    let (frame, column) = (at / motion.num_channels, at % motion.num_channels);
-    let joint = bvh
-        .skeleton
-        .joints
-        .iter()
-        .find(|j| (j.first_channel..j.first_channel + j.channels.len()).contains(&column));
-    Err(Error::NonFinite {
-        frame,
-        joint: joint.map(|j| j.name.clone()).unwrap_or_default(),
-        channel: joint
-            .and_then(|j| j.channels.get(column - j.first_channel))
-            .map(|c| c.name().to_owned())
-            .unwrap_or_default(),
-        value: motion.values.get(at).copied().unwrap_or(f64::NAN),
-    })
-}
-
 /// A derived body with its sources resolved to joint indices.
 struct Derived {
     name: String,
@@ -372,15 +283,6 @@ fn units(
         UnitChoice::Declared(m) => size::declared_units(m, diameter),
         _ => size::choose_units(diameter),
     })
-}
-
-/// World positions of the rest pose (all channels zero, OFFSETs only), metres.
-fn rest_pose(plan: &Plan, world: &ToWorld) -> Vec<Vector3<f64>> {
-    let n = plan.num_joints();
-    let mut q = vec![math::IDENTITY; n];
-    let mut p = vec![[0.0; 3]; n];
-    plan.rest(&mut q, &mut p);
-    p.iter().map(|&x| world.position(x)).collect()
 }
 
 #[cfg(test)]

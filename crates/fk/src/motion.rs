@@ -2,16 +2,8 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+use crate::limits::{MAX_DISTANCE, MAX_STEP};
 use crate::Error;
-
-/// Farthest a body may be from the origin (m) in a valid [`HumanMotion`]: 100 km, far beyond
-/// any capture volume or outdoor inertial recording, and far below the magnitudes (1e300, …)
-/// of a corrupt number. See [`HumanMotion::validate`].
-pub const MAX_DISTANCE: f64 = 1e5;
-
-/// Farthest a body may move between consecutive frames (m) in a valid [`HumanMotion`]:
-/// 100 m, i.e. 3 km/s at 30 fps, where a sprinter moves 0.4 m per frame.
-pub const MAX_STEP: f64 = 100.0;
 
 /// Forward kinematics of a whole clip: per frame, per body, world position (metres, Z up)
 /// and world orientation (continuous in time: consecutive frames never differ in sign).
