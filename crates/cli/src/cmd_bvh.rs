@@ -41,7 +41,7 @@ pub fn run(cmd: BvhCommand) -> anyhow::Result<ExitCode> {
         BvhCommand::Fk(args) => return crate::cmd_bvh_fk::run(&args),
         BvhCommand::Map(args) => return crate::cmd_bvh_map::run(&args),
         BvhCommand::Info { file } => {
-            let bvh = read_bvh(&file)?;
+            let bvh = crate::files::read_bvh(&file)?;
             let summary = bvh::Summary::new(&bvh, &file.display().to_string());
             emit(None, |w| write!(w, "{summary}"))?;
             for line in crate::cmd_bvh_fk::report_lines(&bvh)? {
@@ -49,25 +49,15 @@ pub fn run(cmd: BvhCommand) -> anyhow::Result<ExitCode> {
             }
         }
         BvhCommand::Json { file, output } => {
-            let bvh = read_bvh(&file)?;
+            let bvh = crate::files::read_bvh(&file)?;
             emit(output.as_deref(), |w| bvh::write_json(&bvh, w))?;
         }
         BvhCommand::Cat { file, output } => {
-            let bvh = read_bvh(&file)?;
+            let bvh = crate::files::read_bvh(&file)?;
             emit(output.as_deref(), |w| bvh::write(&bvh, w))?;
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Parse a BVH file and print what the parser tolerated to stderr, one line per warning:
-/// `file:line:column: warning: message`.
-pub fn read_bvh(path: &Path) -> anyhow::Result<bvh::Bvh> {
-    let (bvh, warnings) = bvh::from_path_with_warnings(path)?;
-    for warning in &warnings {
-        eprintln!("{}:{warning}", path.display());
-    }
-    Ok(bvh)
 }
 
 /// Write to `output` atomically, or to standard output when it is `None`. A closed pipe

@@ -82,7 +82,7 @@ fn parse_units(text: &str) -> Result<UnitChoice, String> {
 /// `retarget bvh fk`, from parsed arguments.
 pub fn run(args: &FkArgs) -> anyhow::Result<ExitCode> {
     if let Some(out) = &args.npz {
-        let bvh = crate::cmd_bvh::read_bvh(&args.file)?;
+        let bvh = crate::files::read_bvh(&args.file)?;
         write_npz(&bvh, &args.options(), out).with_context(|| args.file.display().to_string())?;
     }
     print_fk(&args.file, args.frame, &args.options())
@@ -128,7 +128,7 @@ pub fn write_npz(bvh: &bvh::Bvh, options: &FkOptions, out: &Path) -> anyhow::Res
 
 /// Print every body's world pose at `frame`, then the [`FkReport`].
 pub fn print_fk(file: &Path, frame: usize, options: &FkOptions) -> anyhow::Result<ExitCode> {
-    let bvh = crate::cmd_bvh::read_bvh(file)?;
+    let bvh = crate::files::read_bvh(file)?;
     let poses = frame_poses(&bvh, frame, options).with_context(|| file.display().to_string())?;
     println!("{}: {}", file.display(), poses.header());
     for line in poses.lines() {

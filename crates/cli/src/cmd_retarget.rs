@@ -156,7 +156,7 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
             crate::cmd_fbx::retarget(&retargeter, &input, args.take.as_deref(), &robot)?
         } else {
             let bvh =
-                crate::cmd_bvh::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
+                crate::files::read_bvh(&input).with_context(|| format!("{}", input.display()))?;
             let chosen = retargeter
                 .choose_config(&bvh)
                 .with_context(|| format!("{}: choosing the IK config", input.display()))?;

@@ -244,8 +244,7 @@ fn init(
     let label = crate::cmd_retarget::robot_label(robot);
     let (human, against) = match bvh {
         Some(path) => {
-            let file =
-                crate::cmd_bvh::read_bvh(path).with_context(|| path.display().to_string())?;
+            let file = crate::files::read_bvh(path).with_context(|| path.display().to_string())?;
             let human = human_body(&file, &fk::FkOptions::default(), &path.display().to_string())
                 .with_context(|| format!("{}: the skeleton", path.display()))?;
             (human, path.display().to_string())

@@ -15,12 +15,16 @@ mod cmd_retarget;
 mod cmd_robot;
 mod cmd_smpl;
 mod cmd_view;
+mod files;
 mod shipped;
 mod view;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+// The subcommands write through these (`crate::atomic_write`); they live in `files`.
+pub(crate) use files::{atomic_write, atomic_write_with};
 
 /// Retarget human motion capture (BVH, FBX, C3D, AMASS SMPL-X / SMPL+H) onto humanoid robots described in MJCF.
 #[derive(Parser, Debug)]
@@ -111,22 +115,6 @@ fn error_chain(err: &anyhow::Error) -> String {
         }
     }
     parts.join(": ")
-}
-
-/// Write `bytes` to `path` atomically (see [`atomic_write_with`]).
-pub(crate) fn atomic_write(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
-    atomic_write_with(path, |w| w.write_all(bytes))
-}
-
-/// Fill a temporary file beside `path` through `write`, then rename it into place
-/// ([`retarget::writers::write_atomically`]): an interrupted or failed run never leaves a
-/// half-written file under the final name.
-pub(crate) fn atomic_write_with(
-    path: &std::path::Path,
-    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
-) -> anyhow::Result<()> {
-    retarget::writers::write_atomically(path, |w| write(w))
-        .map_err(|e| anyhow::anyhow!("cannot write {e}"))
 }
 
 /// Rust ignores SIGPIPE, which turns `retarget … | head` into a panic in `println!`. A

@@ -264,3 +264,75 @@ mod tests {
         assert_eq!(named, [("left", "ank_roll_link"), ("right", "ank_roll_link_2")]);
     }
 }
+
+#[cfg(test)]
+mod synthetic {
+    //! A hand-made scene (swinging skeleton, a robot of every primitive) for looking at the
+    //! page: `VIEW_SYNTHETIC_OUT=/tmp/s.html cargo test -p cli synthetic`.
+    use super::*;
+    use crate::view::Scene;
+
+    pub fn scene(frames: usize) -> Scene {
+        let xml = r#"<mujoco><worldbody><body name="base" pos="0 0 1">
+          <freejoint/><geom type="box" size="0.1 0.15 0.1"/>
+          <body name="left_leg" pos="0 0.1 -0.1"><joint name="lh" axis="0 1 0" range="-1 1"/>
+            <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
+            <body name="left_ankle_roll_link" pos="0 0 -0.45"><joint name="lk" axis="0 1 0" range="0 2"/>
+              <geom type="cylinder" size="0.05 0.02"/></body></body>
+          <body name="right_leg" pos="0 -0.1 -0.1"><joint name="rh" axis="0 1 0" range="-1 1"/>
+            <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04"/>
+            <body name="right_ankle_roll_link" pos="0 0 -0.45"><joint name="rk" axis="0 1 0"/>
+              <geom type="sphere" size="0.05"/></body></body>
+          <body name="head" pos="0 0 0.25"><geom type="ellipsoid" size="0.08 0.06 0.1"/></body>
+        </body></worldbody></mujoco>"#;
+        let model = model_from_xml(xml).unwrap();
+        let mut qpos = Vec::new();
+        for f in 0..frames {
+            let t = f as f64 / 30.0;
+            let s = (2.0 * t).sin();
+            qpos.extend([
+                0.3 * t,
+                0.0,
+                1.0,
+                1.0,
+                0.0,
+                0.0,
+                0.0,
+                0.6 * s,
+                0.5 + 0.4 * s,
+                -0.6 * s,
+                0.5,
+            ]);
+        }
+        let robot = robot_figure(&model, &qpos, "robot").unwrap();
+        let names: Vec<String> =
+            ["Hips", "LeftFoot", "RightFoot", "Head"].map(String::from).to_vec();
+        let parents = [None, Some(0), Some(0), Some(0)];
+        let pos = (0..frames).flat_map(|f| {
+            let t = f as f64 / 30.0;
+            let x = 0.3 * t + 0.8;
+            let s = 0.3 * (2.0 * t).sin();
+            [[x, 0.0, 1.0], [x + s, 0.1, 0.05], [x - s, -0.1, 0.05], [x, 0.0, 1.6]]
+        });
+        let human = skeleton_figure("human", &names, &parents, pos);
+        Scene {
+            title: "synthetic".into(),
+            fps: 30.0,
+            num_frames: frames,
+            info: vec![("joints".into(), "4".into())],
+            tree: Some("Hips\n  LeftFoot\n  RightFoot\n  Head".into()),
+            skeletons: vec![human],
+            robot: Some(robot),
+            plots: vec![],
+        }
+    }
+
+    #[test]
+    fn synthetic_page() {
+        let html = scene(300).to_html().unwrap();
+        assert!(html.contains("\"check\":[[0,"));
+        if let Some(out) = std::env::var_os("VIEW_SYNTHETIC_OUT") {
+            std::fs::write(out, html).unwrap();
+        }
+    }
+}
