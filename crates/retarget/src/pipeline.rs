@@ -1179,7 +1179,7 @@ fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2]
 ///
 /// LAFAN1, GMR's configs, default solve, mean rotation error against `--gmr`'s (its
 /// position error stays within 1.02× of `--gmr`'s on the G1): G1 walk 1.17× → 1.05×, jumps
-/// 1.24× → 1.09× (with [`PlausibleOptions::twicing`]). On configs whose targets agree with
+/// 1.24× → 1.09× (the per-frame solve with its smoothing filter). On configs whose targets agree with
 /// the robot's legs it trades position for little rotation (every share 1, our derived
 /// config, the G1 on the Bandai walk: 4.29° → 4.04°, 1.55 → 2.97 cm), hence the share.
 pub fn reweigh(
