@@ -95,7 +95,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
         human_height: args.human_height,
         chunk: args
             .chunk_frames
-            .map(|frames| retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in }),
+            .map(|frames| retarget::ChunkOptions { frames, lead_in: args.lead_in }),
         mode: crate::cmd_retarget::solve_mode(args.gmr, args.both_ways),
         ..RetargetOptions::default()
     };

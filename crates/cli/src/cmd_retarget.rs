@@ -118,9 +118,8 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     }
     let started = Instant::now();
     let mode = solve_mode(args.gmr, args.both_ways);
-    let chunk = args
-        .chunk_frames
-        .map(|frames| retarget::chunked::ChunkOptions { frames, lead_in: args.lead_in });
+    let chunk =
+        args.chunk_frames.map(|frames| retarget::ChunkOptions { frames, lead_in: args.lead_in });
     let options = RetargetOptions {
         human_height: args.human_height,
         mode,

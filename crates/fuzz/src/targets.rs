@@ -893,7 +893,7 @@ impl Target for ConfigTarget {
                 map.bodies.len()
             ];
         map.compute(&positions, &orientations, &mut out);
-        let _ = retarget::pipeline::task_specs(&config, model, &map);
+        let _ = retarget::solve::task_specs(&config, model, &map);
         Ok(())
     }
 }

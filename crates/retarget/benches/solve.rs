@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use retarget::lie::Pose;
-use retarget::pipeline::task_specs;
+use retarget::solve::task_specs;
 use retarget::targets::TargetMap;
 use retarget::{IkConfig, Solver, SolverOptions};
 

@@ -11,9 +11,12 @@
 //!    the robot's fit).
 //! 2. **Planting**: during a stance phase the foot target's horizontal position and yaw are
 //!    the phase's anchor ([`Anchor`]), its z puts the sole's lowest point at
-//!    [`FootPlanOptions::clearance`] for the target's tilt (heel and toe rolls stay the
-//!    source's), and the foot task's weights are multiplied by
-//!    [`FootPlanOptions::stance_weight`].
+//!    [`FootPlanOptions::clearance`], and the foot task's weights are multiplied by
+//!    [`FootPlanOptions::stance_weight`]; the sole's bottom points are point tasks that hold it
+//!    there ([`SolePoint`]). The foot stands on its whole sole: the human foot's tilt is
+//!    scaled down until the sole's bottom points are within [`FootPlanOptions::sole_band`] of
+//!    each other, except while the other foot stands too, when it rolls with the human's
+//!    (heel strike, toe off), faded in and out over [`FootPlanOptions::roll_s`].
 //!    A phase over which the source foot turns through more than
 //!    [`FootPlanOptions::pivot_turn`] (45°) is a **pivot**: the planted foot turns with the
 //!    source's yaw about its toe point (which stays on the anchor), as a foot turning on its
@@ -21,26 +24,15 @@
 //!    Overlapping stance phases of the two feet are kept apart; where the left foot stands
 //!    to the right of the right one, they are a [`Crossing`], which the solve can ask to be
 //!    planned again side by side ([`plan_uncrossing`]) when the robot cannot stand in it.
-//! 3. **Blending**: for [`FootPlanOptions::blend_s`] before touch-down and after lift-off the
-//!    planted pose's offset from the free target (position and yaw, taken at the edge) fades
-//!    out along a smoothstep, and so does the weight, so the foot neither jumps onto its
-//!    anchor nor off it. With the same weight, a share ([`FootPlanOptions::ease`], a quarter)
-//!    of the free target's horizontal motion since lift-off (until touch-down) is held back,
-//!    so the foot leaves the floor and lands slower than the human's foot does.
-//! 4. **Swing clearance**: out of stance the target's sole stays at least
-//!    [`FootPlanOptions::swing_clearance`] above the floor. It rises to that height over
-//!    [`FootPlanOptions::lift_s`] after lift-off and comes down from it over the same time
-//!    before touch-down, [`FootPlanOptions::lift_margin`] higher in those frames (at 30 fps,
-//!    one frame, all the way up). While it rises or comes down, the point of the sole it last
-//!    stood on (or first lands on) stays where it was (will be) on the floor, seen from
-//!    above, and the foot turns about it as the blend turns it (a foot standing flat, whose
-//!    corners are all on the floor, only as far as moves none of them more than 3 mm): it
-//!    lifts off before it moves and moves before it comes down. A foot is then either on the floor and still, or
-//!    clear of it. Without this, the swing foot skims the floor at the start and end of every
-//!    step, a few millimetres up and moving at a few dm/s; and while the first frame of a
-//!    swing at 30 fps still moved with the free target (eased), the sole's last contact point
-//!    moved 5–7 mm sideways in it (median, the N1's LAFAN1 walk), and the report counted the
-//!    planted frame before it as sliding: 3.6 % of the G1 walk's contact frames, 0.9 % held.
+//! 3. **Swing**: out of stance the sole stays at least [`FootPlanOptions::swing_clearance`]
+//!    above the floor ([`FootPlan::swing_floor`], which the solve holds as that sole's
+//!    floor), risen to it over [`FootPlanOptions::lift_s`] after lift-off and left over as
+//!    long before touch-down; in those frames the sole points that stood on the floor at
+//!    lift-off (stand on it at touch-down) are held where they were (will be), seen from
+//!    above: a foot leaves the floor by lifting its last contact, not by sliding it.
+//!
+//! The solve ([`crate::solve`]) sees every frame at once: there is no blending of targets
+//! into and out of stance; the accelerations cost it makes the transitions.
 //!
 //! The sole is every collision primitive on the foot body and its descendants, placed as at
 //! `qpos0` relative to the foot body; a foot without collision geometry stands on the

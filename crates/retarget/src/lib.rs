@@ -60,7 +60,7 @@
 //! ```
 //!
 //! Underneath: [`config`] (GMR-schema IK configs), [`derive`](mod@derive) and [`robot_roles`] (configs
-//! derived for any skeleton and robot), [`targets`], [`solver`] and [`pipeline`] (the solve:
+//! derived for any skeleton and robot), [`targets`], [`solver`] and [`solve`] (the solve, stage by stage:
 //! [`SolveMode::Gmr`] is GMR's exactly, the default adds planted feet and hard constraints),
 //! [`motion`], [`writers`] and [`report`]. Every fallible call returns the one [`Error`].
 
@@ -69,7 +69,6 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 pub(crate) mod centroidal;
-pub mod chunked;
 pub mod config;
 pub mod constraints;
 pub mod contact;
@@ -83,7 +82,6 @@ pub mod joint_speed;
 pub mod lie;
 pub mod marker_config;
 pub mod motion;
-pub mod pipeline;
 pub mod qp;
 pub mod report;
 pub mod resample;
@@ -102,10 +100,10 @@ pub use error::Error;
 pub use fbx_clip::FbxClip;
 pub use marker_config::MarkerConfig;
 pub use motion::{FootContacts, RobotMotion, TrackedTargets};
-pub use pipeline::{
-    retarget_bvh, retarget_motion, ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions,
-    SolveMode, SpeedLimits,
-};
 pub use retargeter::{FileResult, HumanFrame, Retargeter};
 pub use robot_roles::{RobotRole, RobotRoles, Sole};
+pub use solve::{
+    retarget_bvh, retarget_motion, retarget_motion_chunked, ChunkOptions, ClipDiagnostics,
+    Planting, PlausibleOptions, RetargetOptions, SolveMode, SpeedLimits,
+};
 pub use solver::{Arithmetic, FrameDiagnostics, Solver, SolverOptions, TaskSpec};

@@ -13,7 +13,7 @@ use mjcf::Model;
 use nalgebra::{Quaternion, UnitQuaternion};
 
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
-use crate::pipeline::Error;
+use crate::Error;
 
 /// `motion` at `fps` frames per second. Joint types come from `model` (the motion's robot).
 pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMotion, Error> {

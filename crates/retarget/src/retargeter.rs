@@ -16,7 +16,7 @@
 //! With the full default solve, `step` runs its causal part ([`PlausibleOptions::causal`] with
 //! the options' other settings).
 //!
-//! [`Planting::Off`]: crate::pipeline::Planting::Off
+//! [`Planting::Off`]: crate::solve::Planting::Off
 
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
@@ -35,11 +35,11 @@ use crate::fbx_clip::FbxClip;
 use crate::lie::Pose;
 use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
-use crate::pipeline::{
+use crate::report::{QualityReport, ReportOptions};
+use crate::solve::{
     build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, PlausibleOptions,
     RetargetOptions, SolveMode,
 };
-use crate::report::{QualityReport, ReportOptions};
 use crate::solver::{FrameDiagnostics, Solver};
 use crate::targets::TargetMap;
 use crate::writers::Format;
@@ -315,7 +315,7 @@ impl Retargeter {
         chosen: &Chosen,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let (motion, mut diag) =
-            crate::pipeline::retarget_bvh(bvh, &self.model, &chosen.config, &self.options)?;
+            crate::solve::retarget_bvh(bvh, &self.model, &chosen.config, &self.options)?;
         diag.human_inferred = if diag.human_inferred.is_empty() {
             chosen.summary.clone()
         } else {
@@ -349,7 +349,7 @@ impl Retargeter {
         let options =
             RetargetOptions { fk: clip.fk_options(&self.options.fk), ..self.options.clone() };
         let (motion, mut diag) =
-            crate::pipeline::retarget_bvh(&clip.bvh, &self.model, &chosen.config, &options)?;
+            crate::solve::retarget_bvh(&clip.bvh, &self.model, &chosen.config, &options)?;
         diag.human_inferred = [clip.summary(), diag.human_inferred, chosen.summary.clone()]
             .into_iter()
             .filter(|s| !s.is_empty())
@@ -424,9 +424,9 @@ impl Retargeter {
         let options = RetargetOptions { human_height: Some(height), ..self.options.clone() };
         match options.chunk {
             Some(chunk) => {
-                crate::chunked::retarget_motion_chunked(human, &self.model, config, &options, chunk)
+                crate::solve::retarget_motion_chunked(human, &self.model, config, &options, chunk)
             }
-            None => crate::pipeline::retarget_motion(human, &self.model, config, &options),
+            None => crate::solve::retarget_motion(human, &self.model, config, &options),
         }
     }
 
@@ -678,9 +678,9 @@ impl Stream {
             let diag = if first && plausible {
                 solve_first_frame(model, solver, tracked, targets)?
             } else {
-                solver.solve_frame(targets, crate::pipeline::first_frame_dt(first, dt))?
+                solver.solve_frame(targets, crate::solve::first_frame_dt(first, dt))?
             };
-            crate::pipeline::reject_divergence(solver.qpos(), index)?;
+            crate::solve::reject_divergence(solver.qpos(), index)?;
             Ok::<_, Error>(diag)
         })?;
         self.last = Some(diag);

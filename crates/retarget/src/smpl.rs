@@ -25,8 +25,8 @@ use smpl::{BodyModel, SmplMotion};
 use crate::config::IkConfig;
 use crate::derive::{Choice, Chosen, HumanBody};
 use crate::motion::RobotMotion;
-use crate::pipeline::{ClipDiagnostics, SolveMode};
 use crate::robot_roles::RobotRoles;
+use crate::solve::{ClipDiagnostics, SolveMode};
 use crate::{Error, Retargeter};
 
 /// The first frame `--gmr` retargets: GMR's `smplx_to_robot.py` starts at frame 1.
@@ -143,16 +143,14 @@ impl Retargeter {
         };
         options.human_height = Some(height);
         let (robot, mut diag) = match options.chunk {
-            Some(chunk) => crate::chunked::retarget_motion_chunked(
+            Some(chunk) => crate::solve::retarget_motion_chunked(
                 &human,
                 self.model(),
                 &chosen.config,
                 &options,
                 chunk,
             ),
-            None => {
-                crate::pipeline::retarget_motion(&human, self.model(), &chosen.config, &options)
-            }
+            None => crate::solve::retarget_motion(&human, self.model(), &chosen.config, &options),
         }
         .map_err(in_file)?;
         diag.human_height_source = source;

@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector};
 
 /// The system: per frame its diagonal block and its blocks towards the frame before and the
 /// one before that (`A_{t,t−1}`, `A_{t,t−2}`; zero for the first frames), and the right-hand
-/// side. Fill with [`Banded::add_diag`], [`Banded::add_coupling`] and `rhs`, then
+/// side. Fill with [`Banded::add`], [`Banded::block_mut`] and `rhs`, then
 /// [`Banded::factor`] and [`Banded::solve`].
 #[derive(Debug, Clone)]
 pub struct Banded {

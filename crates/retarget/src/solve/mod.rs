@@ -1,5 +1,151 @@
-//! The default solve's stages.
+//! The default solve (and GMR's), stage by stage. [`retarget_motion`] is the plan: each
+//! stage is one file of this module, run in this order.
+//!
+//! | # | stage | file | what it does | options |
+//! |---|---|---|---|---|
+//! | 1 | targets | `prepare.rs` | the config's IK targets of every frame (GMR's scaling and offsets), the tasks | [`RetargetOptions`] |
+//! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact::ContactOptions`] |
+//! | 3 | foot plan | `footholds.rs` | the robot's feet planted on them: anchors, soles standing flat, swing floors | [`crate::feet::FootPlanOptions`] |
+//! | 4 | reweighing | `reweigh.rs` | trunk and leg weights where the config's pelvis disagrees with the robot's legs | [`PlausibleOptions`] |
+//! | 5 | first pass | `first_pass.rs` | every frame solved causally with the hard constraints (what streams run) | [`crate::SolverOptions`] |
+//! | 6 | trajectory | `trajectory.rs`, `windows.rs`, `banded.rs`, `dynamics.rs` | every frame of a window at once: tracking, smooth accelerations of every coordinate, the wrench the feet cannot supply, every constraint | [`TrajectoryOptions`], [`DynamicsOptions`] |
+//! | 7 | uncrossing | `uncross.rs` | crossed stances the robot could not stand in, planned side by side and solved again | [`PlausibleOptions::uncross_stuck`] |
+//!
+//! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
+//! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
+//! 2 and 5 with GMR's solver and nothing else.
 
-pub mod banded;
+mod banded;
+mod contacts;
 pub mod dynamics;
+mod first_pass;
+mod footholds;
+mod options;
+mod prepare;
+mod reweigh;
+mod schedule;
 pub mod trajectory;
+mod uncross;
+mod windows;
+
+use std::ops::Range;
+use std::time::Instant;
+
+use bvh::Bvh;
+use fk::HumanMotion;
+use mjcf::Model;
+
+pub use banded::{Banded, NotPositiveDefinite};
+pub use dynamics::DynamicsOptions;
+pub(crate) use first_pass::{build_solver, first_frame_dt, solve_first_frame};
+pub use options::{
+    ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
+    SpeedLimits,
+};
+pub use prepare::task_specs;
+pub(crate) use prepare::{finite_pose, reject_divergence};
+pub use reweigh::reweigh;
+pub use schedule::ChunkOptions;
+pub use trajectory::TrajectoryOptions;
+pub use uncross::{LEGS_TOUCH, RESOLVE_LEAD_IN, RESOLVE_MARGIN, UNCROSS_SINK, UNCROSS_STUCK};
+
+use crate::config::IkConfig;
+use crate::motion::RobotMotion;
+use crate::Error;
+use prepare::{Prepared, Solved};
+
+/// Human FK of `bvh`, then [`retarget_motion`].
+pub fn retarget_bvh(
+    bvh: &Bvh,
+    model: &Model,
+    config: &IkConfig,
+    options: &RetargetOptions,
+) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    let mut fk_options = options.fk.clone();
+    if options.human_height.is_some() {
+        fk_options.height = options.human_height;
+    }
+    let (human, report) = fk::human_motion(bvh, &fk_options)?;
+    let mut opts = options.clone();
+    opts.human_height = Some(report.height);
+    // The recognised roles, so that the source's feet are found whatever their names.
+    if let Ok(humanoid) = &report.humanoid {
+        for (role, joint) in humanoid.roles.iter() {
+            opts.fk.roles.entry(role).or_insert_with(|| joint.name.clone());
+        }
+    }
+    let (motion, mut diag) = retarget_motion(&human, model, config, &opts)?;
+    diag.human_inferred = report.inferred();
+    diag.human_height_source = report.height_source;
+    Ok((motion, diag))
+}
+
+/// Retargets a human motion (world poses, metres, Z up) onto `model`: the stages in order.
+/// The subject height is `options.human_height` (required here: the FK report has it for
+/// BVH input).
+pub fn retarget_motion(
+    human: &HumanMotion,
+    model: &Model,
+    config: &IkConfig,
+    options: &RetargetOptions,
+) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    // 1. The targets.
+    let mut prepared = Prepared::new(human, model, config, options)?;
+    // 2. The source's contacts.
+    prepared.detect_contacts(human);
+    // 3. The foot plan.
+    prepared.plan();
+    // 4. Reweighing.
+    prepared.reweigh_where_planted()?;
+    let start = Instant::now();
+    // 5 and 6. The first pass and the trajectory solve, over the schedule.
+    let n = prepared.num_frames();
+    let mut solved = match options.chunk {
+        None => solve_range(&prepared, 0..n, 0)?,
+        Some(chunk) => schedule::solve_chunks(&prepared, chunk)?,
+    };
+    // 7. Uncrossing.
+    prepared.resolve_uncrossed(&mut solved)?;
+    Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
+}
+
+/// [`retarget_motion`] with the clip solved as chunks in parallel (rayon's current pool).
+pub fn retarget_motion_chunked(
+    human: &HumanMotion,
+    model: &Model,
+    config: &IkConfig,
+    options: &RetargetOptions,
+    chunk: ChunkOptions,
+) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    let options = RetargetOptions { chunk: Some(chunk), ..options.clone() };
+    retarget_motion(human, model, config, &options)
+}
+
+/// Frames `range` of `prepared` through stages 5 and 6, from `qpos0` at `range.start −
+/// lead_in` (the lead-in's frames are solved and dropped) to a window's overlap past its end
+/// (the trajectory solve's last frames need the frames after them in view).
+pub(crate) fn solve_range(
+    prepared: &Prepared<'_>,
+    range: Range<usize>,
+    lead_in: usize,
+) -> Result<Solved, Error> {
+    let nq = prepared.model.nq;
+    let first = range.start.saturating_sub(lead_in);
+    let trajectory = match &prepared.options.mode {
+        SolveMode::Plausible(p) if p.trajectory.iterations > 0 => Some(&p.trajectory),
+        _ => None,
+    };
+    let ahead = trajectory.map_or(0, |t| trajectory::overlap_frames(t, prepared.fps));
+    let end = (range.end + ahead).min(prepared.num_frames());
+    let mut solver = prepared.solver()?;
+    // 5. The first pass.
+    let (mut qpos, mut frames) = prepared.first_pass(&mut solver, first..end)?;
+    // 6. The trajectory solve.
+    if let (Some(options), false) = (trajectory, qpos.is_empty()) {
+        prepared.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
+    }
+    let skip = range.start - first;
+    qpos.truncate((range.end - first) * nq);
+    frames.truncate(range.end - first);
+    Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
+}

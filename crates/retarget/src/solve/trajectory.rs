@@ -14,7 +14,7 @@
 //! `W` weighs the acceleration of every velocity coordinate, the free root's translation and
 //! rotation included ([`TrajectoryOptions`]). Gauss–Newton: each iteration linearises the
 //! tasks at the current trajectory and solves the window's quadratic model in one piece, a
-//! block-pentadiagonal system ([`super::banded`]: a second difference couples three frames)
+//! block-pentadiagonal system (`banded.rs`: a second difference couples three frames)
 //! in which the constraints that are active (within [`TrajectoryOptions::active_slack`] of
 //! their bound, or past it) are held by a stiff penalty
 //! ([`TrajectoryOptions::active_penalty`]); then one sweep over the frames solves each

@@ -1,4 +1,4 @@
-//! Solving one long clip as chunks in parallel.
+//! The schedule of stages 5 and 6: one long clip as chunks in parallel.
 //!
 //! The solver is sequential (each frame warm-starts from the previous one), so a long clip
 //! uses one core. Here the clip is cut into chunks of `frames` frames; each chunk is solved
@@ -12,15 +12,11 @@
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
-use std::time::Instant;
-
-use fk::HumanMotion;
 use mjcf::Model;
 use rayon::prelude::*;
 
-use crate::config::IkConfig;
-use crate::motion::RobotMotion;
-use crate::pipeline::{ClipDiagnostics, Error, Prepared, RetargetOptions, Solved};
+use super::prepare::{Prepared, Solved};
+use crate::Error;
 
 /// How to cut a clip: chunks of `frames` frames, each preceded by `lead_in` frames of warm-up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,26 +32,21 @@ impl Default for ChunkOptions {
     }
 }
 
-/// [`retarget_motion`](crate::retarget_motion) with the clip solved as parallel chunks
-/// (rayon's current pool). Targets, contacts and foot plans are prepared once for the whole
-/// clip; the result has the same layout as the serial one.
-pub fn retarget_motion_chunked(
-    human: &HumanMotion,
-    model: &Model,
-    config: &IkConfig,
-    options: &RetargetOptions,
-    chunk: ChunkOptions,
-) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+/// Frames `0..n` of `prepared` solved as chunks on rayon's current pool (stages 5 and 6 of
+/// each, [`super::solve_range`]) and stitched, each chunk's quaternions continued across
+/// its seam.
+pub(super) fn solve_chunks(prepared: &Prepared<'_>, chunk: ChunkOptions) -> Result<Solved, Error> {
     if chunk.frames == 0 {
         return Err(Error::InvalidOption("chunks need at least one frame".to_owned()));
     }
-    let mut prepared = Prepared::new(human, model, config, options)?;
+    let model = prepared.model;
     let n = prepared.num_frames();
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
-    let started = Instant::now();
     let parts = starts
         .par_iter()
-        .map(|&start| prepared.solve(start..(start + chunk.frames).min(n), chunk.lead_in))
+        .map(|&start| {
+            super::solve_range(prepared, start..(start + chunk.frames).min(n), chunk.lead_in)
+        })
         .collect::<Result<Vec<Solved>, Error>>()?;
     let mut solved =
         Solved { qpos: Vec::with_capacity(n * model.nq), frames: Vec::with_capacity(n) };
@@ -67,9 +58,7 @@ pub fn retarget_motion_chunked(
         solved.qpos.extend(part.qpos);
         solved.frames.extend(part.frames);
     }
-    prepared.resolve_uncrossed(&mut solved)?;
-    let seconds = started.elapsed().as_secs_f64();
-    Ok(prepared.finish(solved.qpos, solved.frames, seconds))
+    Ok(solved)
 }
 
 /// Negates a chunk's quaternions (free and ball joints; `qpos`: its frames) where its first

@@ -1,0 +1,263 @@
+//! The solve's options and what it reports of a clip.
+
+// Indexing: per-frame diagnostics hold one entry per tracked body, as `body_names` does.
+#![allow(clippy::indexing_slicing)]
+
+use crate::solver::{FrameDiagnostics, SolverOptions};
+use fk::FkOptions;
+use std::ops::Range;
+
+/// Which solve [`retarget_motion`](super::retarget_motion) runs.
+// (One per solve, never in a loop or a collection: boxing the options would only make them
+// harder to build.)
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolveMode {
+    /// GMR's algorithm and targets, reproduced exactly (`--gmr`; `tests/parity.rs`).
+    Gmr,
+    /// The default: GMR's targets and weights as the tracking objective, with the source's
+    /// contact phases planted on the floor and hard constraints (ground, joint speed).
+    Plausible(PlausibleOptions),
+}
+
+impl Default for SolveMode {
+    fn default() -> Self {
+        SolveMode::Plausible(PlausibleOptions::default())
+    }
+}
+
+/// Tunables of [`SolveMode::Plausible`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlausibleOptions {
+    /// Whether the robot's feet are planted on the floor during the source's contact phases
+    /// (this plans over the whole clip, so it needs the future). The phases themselves are
+    /// detected and written in every mode.
+    pub planting: Planting,
+    pub contact: crate::contact::ContactOptions,
+    pub feet: crate::feet::FootPlanOptions,
+    /// Every collision geom stays above this height (m): the floor, for the ground
+    /// constraint.
+    pub floor: f64,
+    /// Hold the joints' speed limits (`mjcf::Joint::velocity_limit`) as hard bounds.
+    pub speed_limits: SpeedLimits,
+    /// Keep the robot's own geoms apart ([`crate::constraints::SelfCollision`]).
+    pub self_collision: SelfCollisionMode,
+    /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
+    /// [`reweigh`](super::reweigh::reweigh)) where the config pins the pelvis at a height that disagrees with the
+    /// robot's legs (its position weight above [`PlausibleOptions::root_position_weight_cap`],
+    /// [`PlausibleOptions::pelvis_offset_range`]). GMR balanced
+    /// its leg rotation weights (5–10) against feet that follow the human's; planted, the
+    /// feet and the pelvis position decide the legs' posture and the legs' orientations gave
+    /// way (the G1's hips and knees 2–4° further from their targets than with GMR's solve).
+    pub trunk_rotation_scale: f64,
+    /// The root's position weight is at most this ([`reweigh`](super::reweigh::reweigh)) where the config's targets
+    /// disagree with the robot's legs. GMR weighs the G1's and the H1's pelvis position 100
+    /// (its other configs 10–50): with the feet planted on the floor, that held the G1's
+    /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
+    pub root_position_weight_cap: f64,
+    /// How far (m) the robot's pelvis stands above or below its target, median over a few
+    /// windows of the clip solved with the config's weights (`Prepared::pelvis_offset`),
+    /// over which the two changes above fade in (smoothstep from the first to the second).
+    /// Measured where the root's position weight is above the cap: GMR's G1 config on the
+    /// LAFAN1 walk / jumps 1.3 / 2.8 cm, its H1 config 5.0 / 3.5; our derived configs
+    /// (pelvis weight 100 too) 0–0.5 cm on CMU, Mixamo, Rigify and the Bandai kick and run,
+    /// 0.5–1.8 cm on the Bandai walks and dance (their scales come from the robot's limbs).
+    pub pelvis_offset_range: [f64; 2],
+    /// Also run the first pass backwards, from the clip's last frame to its first, and
+    /// hand over to it where it tracks better (the sum of the frames' tracking errors lower by
+    /// more than the median frame's error per switch, switching only where the two passes
+    /// agree to 0.05 rad and 5 cm, so that no switch is a jump). A warm-started solve keeps
+    /// the branch a limb is in: on the Bandai kick the PM01's right hip went over into the
+    /// hip's other branch (pitch and roll at their limits, yaw −200°) for the 300 frames after
+    /// the kick, and the backward pass, which reaches the kick from the normal stance, never
+    /// does. Costs a second first pass, run on a second thread of rayon's pool.
+    pub both_ways: bool,
+    /// Where the robot could not stand in a crossed stance ([`crate::feet::Crossing`]: in a
+    /// frame both feet are down, a planted foot [`UNCROSS_STUCK`](super::uncross::UNCROSS_STUCK) or further from its target,
+    /// the legs within [`LEGS_TOUCH`](super::uncross::LEGS_TOUCH) of each other and the pelvis [`UNCROSS_SINK`](super::uncross::UNCROSS_SINK) or more
+    /// below its target), plan those steps again side by side and solve their frames again.
+    /// The human crosses over in a crouch on the LAFAN1 walk (near frames 2990, 3240 and 3300,
+    /// the right foot landing 11 cm to the left of the left one); the T1's legs are too thick
+    /// for it: held crossed, its self-collision rows lifted its planted feet up to 10 cm and
+    /// sank its pelvis up to 19 cm below its target. Uncrossing every crossed stance instead
+    /// kept the T1's feet down but tripled the foot error of every robot (the G1's walk 14 →
+    /// 49 mm), whose legs cross there without trouble. Costs solving again the frames whose
+    /// targets that changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps,
+    /// 504 frames of 7,184 with the margins and lead-in; 5 % more time).
+    pub uncross_stuck: bool,
+    /// The trajectory solve over every frame ([`crate::solve::trajectory`]); 0 iterations:
+    /// the first pass alone.
+    pub trajectory: crate::solve::trajectory::TrajectoryOptions,
+    /// [`SolverOptions::max_extra_steps`] of this solve (GMR: 10).
+    pub max_extra_steps: usize,
+}
+
+/// Whether [`SolveMode::Plausible`] plants the feet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Planting {
+    On,
+    /// No planted foot targets: the targets are GMR's (the contact labels are still written).
+    Off,
+}
+
+/// Whether the solve keeps the robot's geoms apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelfCollisionMode {
+    On,
+    Off,
+}
+
+/// Whether the solve holds the robot's joint speed limits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedLimits {
+    /// Per joint, `mjcf::Joint::velocity_limit` where it is set.
+    Robot,
+    Off,
+}
+
+impl Default for PlausibleOptions {
+    fn default() -> Self {
+        PlausibleOptions {
+            planting: Planting::On,
+            contact: crate::contact::ContactOptions::default(),
+            feet: crate::feet::FootPlanOptions::default(),
+            floor: 0.0,
+            speed_limits: SpeedLimits::Robot,
+            self_collision: SelfCollisionMode::On,
+            trunk_rotation_scale: 2.0,
+            root_position_weight_cap: 20.0,
+            pelvis_offset_range: [0.005, 0.015],
+            both_ways: false,
+            uncross_stuck: true,
+            trajectory: crate::solve::trajectory::TrajectoryOptions::default(),
+            max_extra_steps: 10,
+        }
+    }
+}
+
+impl PlausibleOptions {
+    /// The causal part of the default solve: GMR's tasks with the hard constraints (ground,
+    /// self-collision, joint speed), warm-started frame by frame; no foot planting, no
+    /// smoothing and no backward pass, which all need the frames that follow. What streaming
+    /// ([`crate::Retargeter::step`]) runs; a clip solved with it gives the same numbers.
+    #[must_use]
+    pub fn causal() -> PlausibleOptions {
+        PlausibleOptions {
+            planting: Planting::Off,
+            both_ways: false,
+            uncross_stuck: false,
+            trajectory: crate::solve::trajectory::TrajectoryOptions {
+                iterations: 0,
+                ..Default::default()
+            },
+            ..PlausibleOptions::default()
+        }
+    }
+}
+
+/// Options of [`retarget_bvh`](super::retarget_bvh) / [`retarget_motion`](super::retarget_motion).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RetargetOptions {
+    /// Subject height in metres; `None` uses the FK estimate (GMR assumes 1.75).
+    pub human_height: Option<f64>,
+    pub solver: SolverOptions,
+    /// FK options. Their `roles` also name the source's feet for the contact phases
+    /// ([`crate::contact::human_foot_points`]); [`retarget_bvh`](super::retarget_bvh) adds the recognised ones.
+    pub fk: FkOptions,
+    /// Solve long clips as parallel chunks ([`retarget_motion_chunked`](super::retarget_motion_chunked)); `None`: one serial pass.
+    pub chunk: Option<super::ChunkOptions>,
+    /// The default solve or GMR's.
+    pub mode: SolveMode,
+}
+
+impl RetargetOptions {
+    /// GMR's exact solve.
+    #[must_use]
+    pub fn gmr() -> RetargetOptions {
+        RetargetOptions { mode: SolveMode::Gmr, ..RetargetOptions::default() }
+    }
+
+    /// The default solve's causal part ([`PlausibleOptions::causal`]).
+    #[must_use]
+    pub fn causal() -> RetargetOptions {
+        let mode = SolveMode::Plausible(PlausibleOptions::causal());
+        RetargetOptions { mode, ..RetargetOptions::default() }
+    }
+}
+
+/// Per-clip diagnostics: per frame, and which bodies the per-body arrays refer to.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ClipDiagnostics {
+    /// Tracked robot bodies (same order as [`TrackedTargets::body_names`](crate::motion::TrackedTargets::body_names)).
+    pub body_names: Vec<String>,
+    /// Per tracked body: whether some stage gives it a non-zero position weight (its
+    /// position error is meaningful) ...
+    pub position_tracked: Vec<bool>,
+    /// ... and a non-zero rotation weight.
+    pub rotation_tracked: Vec<bool>,
+    pub frames: Vec<FrameDiagnostics>,
+    /// Subject height used for scaling (m) and where it came from.
+    pub human_height: f64,
+    pub human_height_source: String,
+    /// What FK inferred about the source, in one line ([`fk::FkReport::inferred`]: up axis,
+    /// unit, skeleton roles, rest pose); empty when a `HumanMotion` was given directly.
+    pub human_inferred: String,
+    /// Wall time of the IK alone (seconds).
+    pub solve_seconds: f64,
+    /// How far (m) the robot's pelvis stood above or below its target with the config's
+    /// weights ([`PlausibleOptions::pelvis_offset_range`]; default solve with planted feet),
+    /// and the share of [`reweigh`](super::reweigh::reweigh)'s changes applied (0 to 1).
+    pub pelvis_offset: Option<f64>,
+    pub reweigh_share: f64,
+    /// Frames of the crossed stances planned again uncrossed
+    /// ([`PlausibleOptions::uncross_stuck`]), in order.
+    pub uncrossed: Vec<Range<usize>>,
+}
+
+impl ClipDiagnostics {
+    /// Frames taken from the backward first pass ([`PlausibleOptions::both_ways`]) and the
+    /// stretches they form.
+    #[must_use]
+    pub fn from_backward(&self) -> (usize, usize) {
+        let frames = self.frames.iter().filter(|f| f.backward).count();
+        let starts = self
+            .frames
+            .iter()
+            .enumerate()
+            .filter(|&(t, f)| f.backward && (t == 0 || !self.frames[t - 1].backward))
+            .count();
+        (frames, starts)
+    }
+
+    /// Per body: mean and 95th percentile of the position error (m) over the frames.
+    #[must_use]
+    pub fn position_error_stats(&self) -> Vec<(f64, f64)> {
+        self.stats(|f, k| f.pos_error[k])
+    }
+
+    /// Per body: mean and 95th percentile of the rotation error (rad) over the frames.
+    #[must_use]
+    pub fn rotation_error_stats(&self) -> Vec<(f64, f64)> {
+        self.stats(|f, k| f.rot_error[k])
+    }
+
+    /// Frames with at least one joint at a limit, and the total joint-frames at a limit.
+    #[must_use]
+    pub fn limit_hits(&self) -> (usize, usize) {
+        let frames = self.frames.iter().filter(|f| !f.at_limit.is_empty()).count();
+        (frames, self.frames.iter().map(|f| f.at_limit.len()).sum())
+    }
+
+    fn stats(&self, value: impl Fn(&FrameDiagnostics, usize) -> f64) -> Vec<(f64, f64)> {
+        (0..self.body_names.len())
+            .map(|k| {
+                let v: Vec<f64> = self.frames.iter().map(|f| value(f, k)).collect();
+                if v.is_empty() {
+                    return (0.0, 0.0);
+                }
+                let mean = v.iter().sum::<f64>() / v.len() as f64;
+                (mean, crate::report::percentile(&v, 0.95))
+            })
+            .collect()
+    }
+}

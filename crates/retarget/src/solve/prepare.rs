@@ -1,0 +1,283 @@
+//! Stage 1, the targets: every frame's IK targets from the config (scaled, offset), the
+//! task setup, and what the later stages share ([`Prepared`]).
+
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in
+// `prepare`), body ids come from the model; the human motion's sizes are checked by
+// `HumanMotion::validate` first.
+#![allow(clippy::indexing_slicing)]
+
+use std::ops::Range;
+
+use mjcf::{JointType, Model};
+use nalgebra::{UnitQuaternion, Vector3};
+
+use super::first_pass::build_solver;
+use super::{ClipDiagnostics, RetargetOptions, SolveMode};
+use crate::config::IkConfig;
+use crate::feet::{FootPlan, RobotFoot};
+use crate::lie::Pose;
+use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
+use crate::solver::{FrameDiagnostics, Solver, TaskSpec};
+use crate::targets::TargetMap;
+use crate::Error;
+use fk::HumanMotion;
+
+/// One clip made ready to solve: every frame's targets (foot-planned in the default mode),
+/// the source's contacts and the task setup. Solving frame ranges of it independently is
+/// how [`crate::chunked`] parallelises a clip.
+pub(crate) struct Prepared<'a> {
+    // (The stages' files read and write these fields.)
+    pub(super) model: &'a Model,
+    pub(super) options: &'a RetargetOptions,
+    pub(super) stages: Vec<Vec<TaskSpec>>,
+    /// `(body, target slot)` of each tracked body, as [`Solver::tracked`] orders them.
+    pub(super) tracked: Vec<(usize, usize)>,
+    pub(super) slots: usize,
+    /// `frames × slots` targets.
+    pub(super) targets: Vec<Pose>,
+    pub(super) contacts: Option<FootContacts>,
+    /// Foot bodies and per-frame weight factors (default mode).
+    pub(super) plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
+    /// The targets before the foot plan rewrote them (default mode, planted feet), to plan
+    /// again from ([`Prepared::uncross_stuck`]), and the stance overlaps uncrossed.
+    pub(super) unplanned: Option<Vec<Pose>>,
+    pub(super) uncrossed: Vec<Range<usize>>,
+    pub(super) fps: f64,
+    pub(super) height: f64,
+    /// Target slot of the human root.
+    pub(super) root_target: usize,
+    /// [`ClipDiagnostics::pelvis_offset`] and [`ClipDiagnostics::reweigh_share`].
+    pub(super) pelvis_offset: Option<f64>,
+    pub(super) reweigh_share: f64,
+}
+
+/// Solved frames of a range.
+pub(crate) struct Solved {
+    pub qpos: Vec<f64>,
+    pub frames: Vec<FrameDiagnostics>,
+}
+
+impl<'a> Prepared<'a> {
+    pub(crate) fn new(
+        human: &HumanMotion,
+        model: &'a Model,
+        config: &IkConfig,
+        options: &'a RetargetOptions,
+    ) -> Result<Prepared<'a>, Error> {
+        human.validate()?;
+        let height = options
+            .human_height
+            .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
+        config.validate(model, &human.body_names)?;
+        let map = TargetMap::new(config, &human.body_names, height)?;
+        let stages = task_specs(config, model, &map);
+        let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
+        let (nb, nf) = (human.num_bodies(), human.num_frames);
+        let slots = map.bodies.len();
+        let mut targets =
+            vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
+        for f in 0..nf {
+            let range = f * nb..(f + 1) * nb;
+            let out = &mut targets[f * slots..(f + 1) * slots];
+            map.compute(&human.positions[range.clone()], &human.orientations[range], out);
+            if let Some(bad) = out.iter().position(|p| !finite_pose(p)) {
+                let message =
+                    format!("target of human body `{}` is not finite", map.bodies[bad].name);
+                return Err(Error::NonFinite { frame: f, message });
+            }
+        }
+        let prepared = Prepared {
+            model,
+            options,
+            stages,
+            tracked,
+            slots,
+            targets,
+            contacts: None,
+            plan: None,
+            unplanned: None,
+            uncrossed: Vec::new(),
+            fps: human.fps,
+            height,
+            root_target: map.root,
+            pelvis_offset: None,
+            reweigh_share: 0.0,
+        };
+        Ok(prepared)
+    }
+
+    /// The robot body a task follows the human root's target with.
+    pub(super) fn root_body(&self) -> Option<usize> {
+        self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
+    }
+
+    /// Per frame, the yaw (rad) the robot's pelvis is to face: the root target's turn of the
+    /// body's forward direction (world +x at `qpos0`, as for the feet). Empty when no task
+    /// follows the root target.
+    pub(super) fn heading(&self) -> Vec<f64> {
+        let Some(body) = self.root_body() else { return Vec::new() };
+        let mut data = mjcf::Data::new(self.model);
+        self.model.kinematics(&self.model.qpos0, &mut data);
+        let forward = data.xquat[body].inverse() * Vector3::x();
+        (0..self.num_frames())
+            .map(|t| {
+                let p = &self.frame_targets(t)[self.root_target];
+                let q = UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+                    p.quat[0], p.quat[1], p.quat[2], p.quat[3],
+                ));
+                let f = q * forward;
+                f.y.atan2(f.x)
+            })
+            .collect()
+    }
+
+    pub(super) fn contact_weight(&self) -> f64 {
+        match &self.options.mode {
+            SolveMode::Plausible(p) => p.feet.contact_weight,
+            SolveMode::Gmr => 0.0,
+        }
+    }
+
+    /// A solver for this clip: GMR's, or with the default mode's constraints.
+    pub(super) fn solver(&self) -> Result<Solver<'a>, Error> {
+        build_solver(self.model, &self.stages, self.options)
+    }
+
+    /// Seconds between frames (0 for a clip without a rate).
+    pub(super) fn frame_dt(&self) -> f64 {
+        if self.fps > 0.0 {
+            1.0 / self.fps
+        } else {
+            0.0
+        }
+    }
+
+    pub(super) fn frame_targets(&self, f: usize) -> &[Pose] {
+        &self.targets[f * self.slots..(f + 1) * self.slots]
+    }
+
+    /// The clip's motion and diagnostics from its solved frames (all of them, in order).
+    pub(crate) fn finish(
+        &self,
+        qpos: Vec<f64>,
+        frames: Vec<FrameDiagnostics>,
+        solve_seconds: f64,
+    ) -> (RobotMotion, ClipDiagnostics) {
+        let model = self.model;
+        let nf = frames.len();
+        let mut target_pos = Vec::with_capacity(nf * self.tracked.len());
+        let mut target_quat = Vec::with_capacity(nf * self.tracked.len());
+        for f in 0..nf {
+            for &(_, t) in &self.tracked {
+                let p = &self.targets[f * self.slots + t];
+                target_pos.push(p.pos);
+                let q = nalgebra::Quaternion::new(p.quat[0], p.quat[1], p.quat[2], p.quat[3]);
+                target_quat.push(UnitQuaternion::new_unchecked(q));
+            }
+        }
+        let body_name = |b: usize| model.bodies[b].name.clone();
+        let tracked_names: Vec<String> = self.tracked.iter().map(|&(b, _)| body_name(b)).collect();
+        let motion = RobotMotion {
+            fps: self.fps,
+            nq: model.nq,
+            qpos,
+            joint_names: RobotMotion::model_joint_names(model),
+            body_names: RobotMotion::model_body_names(model),
+            targets: Some(TrackedTargets {
+                body_names: tracked_names.clone(),
+                pos: target_pos,
+                quat: target_quat,
+            }),
+            contacts: self.contacts.clone(),
+        };
+        let stages = &self.stages;
+        let weighted = |body: usize, pick: fn(&TaskSpec) -> f64| {
+            stages.iter().flatten().any(|t| t.body == body && pick(t) != 0.0)
+        };
+        let diag = ClipDiagnostics {
+            body_names: tracked_names,
+            position_tracked: self
+                .tracked
+                .iter()
+                .map(|&(b, _)| weighted(b, |t| t.pos_weight))
+                .collect(),
+            rotation_tracked: self
+                .tracked
+                .iter()
+                .map(|&(b, _)| weighted(b, |t| t.rot_weight))
+                .collect(),
+            frames,
+            human_height: self.height,
+            human_height_source: "given".to_owned(),
+            human_inferred: String::new(),
+            solve_seconds,
+            pelvis_offset: self.pelvis_offset,
+            reweigh_share: self.reweigh_share,
+            uncrossed: self.uncrossed.clone(),
+        };
+        (motion, diag)
+    }
+
+    pub(crate) fn num_frames(&self) -> usize {
+        self.targets.len().checked_div(self.slots).unwrap_or(0)
+    }
+}
+
+impl crate::solve::trajectory::Frames for Prepared<'_> {
+    fn targets(&self, frame: usize) -> &[Pose] {
+        self.frame_targets(frame)
+    }
+
+    fn configure(&self, solver: &mut Solver<'_>, frame: usize) -> Result<(), Error> {
+        self.set_frame_tasks(solver, frame)
+    }
+
+    fn root_reference(&self, frame: usize) -> Option<(Pose, bool)> {
+        let free = self.model.joints.iter().find(|j| j.kind == JointType::Free)?;
+        let body = self.root_body()?;
+        Some((self.frame_targets(frame)[self.root_target], body == free.body))
+    }
+}
+
+/// Active entries of each enabled table as solver tasks; target slots index `map.bodies`.
+#[must_use]
+pub fn task_specs(config: &IkConfig, model: &Model, map: &TargetMap) -> Vec<Vec<TaskSpec>> {
+    config
+        .stages()
+        .into_iter()
+        .map(|table| {
+            table
+                .iter()
+                .filter(|e| e.is_active())
+                .filter_map(|e| {
+                    Some(TaskSpec {
+                        body: model.body_id(&e.robot_body)?,
+                        target: map.index_of(&e.human_body)?,
+                        pos_weight: e.pos_weight,
+                        rot_weight: e.rot_weight,
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A configuration no solve of a real motion reaches: a coordinate not finite, or beyond
+/// [`fk::MAX_DISTANCE`] (100 km for the root, as many radians for a joint). Written output
+/// must never hold one (a near-singular step once put a root at 6.7e10 m).
+pub(super) fn diverged(qpos: &[f64]) -> bool {
+    qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
+}
+
+/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
+pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
+    if diverged(qpos) {
+        return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });
+    }
+    Ok(())
+}
+
+pub(crate) fn finite_pose(p: &Pose) -> bool {
+    p.pos.iter().all(|v| v.is_finite()) && p.quat.iter().all(|v| v.is_finite())
+}
