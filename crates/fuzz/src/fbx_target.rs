@@ -471,7 +471,7 @@ impl Target for FbxTarget {
     }
 
     fn seeds(&self) -> Vec<Vec<u8>> {
-        let mut seeds = crate::targets::files("crates/fbx/tests/data", ".fbx");
+        let mut seeds = crate::seeds::files("crates/fbx/tests/data", ".fbx");
         for k in 0..3u8 {
             let entropy: Vec<u8> =
                 (0..4096u32).map(|i| (i * 31 + u32::from(k) * 97) as u8).collect();

@@ -24,6 +24,7 @@ pub mod amass;
 pub mod fbx_target;
 pub mod guard;
 mod mutate;
+mod seeds;
 pub mod targets;
 
 use std::collections::HashSet;

@@ -5,11 +5,11 @@
 
 use std::fmt::Write as _;
 use std::io::Cursor;
-use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use arbitrary::{Arbitrary, Result, Unstructured};
 
+use crate::seeds::files;
 use crate::Target;
 
 /// Every target, by name.
@@ -31,20 +31,6 @@ pub fn all() -> Vec<Box<dyn Target>> {
 #[must_use]
 pub fn by_name(name: &str) -> Option<Box<dyn Target>> {
     all().into_iter().find(|t| t.name() == name)
-}
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// Files under `dir` (relative to the workspace) whose name ends with `suffix`.
-pub(crate) fn files(dir: &str, suffix: &str) -> Vec<Vec<u8>> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(workspace().join(dir))
-        .map(|entries| entries.flatten().map(|e| e.path()).collect())
-        .unwrap_or_default();
-    paths.retain(|p| p.to_string_lossy().ends_with(suffix));
-    paths.sort();
-    paths.iter().filter_map(|p| std::fs::read(p).ok()).collect()
 }
 
 fn text(input: &[u8]) -> std::result::Result<&str, String> {
@@ -1139,8 +1125,9 @@ impl Target for NpzTarget {
     }
 
     fn run(&self, input: &[u8]) -> std::result::Result<(), String> {
-        let motion = retarget::writers::read_motion_npz_bytes(input, Path::new("fuzz.npz"))
-            .map_err(|e| e.to_string())?;
+        let motion =
+            retarget::writers::read_motion_npz_bytes(input, std::path::Path::new("fuzz.npz"))
+                .map_err(|e| e.to_string())?;
         let _ = motion.num_frames();
         let report =
             retarget::report::report(&motion, g1(), &retarget::report::ReportOptions::default())

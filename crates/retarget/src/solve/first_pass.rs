@@ -16,10 +16,9 @@ use nalgebra::Vector3;
 
 use super::prepare::reject_divergence;
 use super::prepare::Prepared;
-use super::{RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits};
-use crate::constraints::{Ground, SelfCollision};
+use super::SolveMode;
 use crate::lie::Pose;
-use crate::solver::{FrameDiagnostics, Solver, TaskSpec};
+use crate::solver::{FrameDiagnostics, Solver};
 use crate::Error;
 
 impl<'a> Prepared<'a> {
@@ -96,33 +95,6 @@ impl<'a> Prepared<'a> {
         }
         Ok((qpos, frames))
     }
-}
-
-/// The solver of a clip or a stream: GMR's, or with the default mode's constraints (ground,
-/// self-collision, joint speed limits). The one place both [`retarget_motion`] and
-/// [`crate::Retargeter::step`] build it, so that they solve the same problem.
-pub(crate) fn build_solver<'m>(
-    model: &'m Model,
-    stages: &[Vec<TaskSpec>],
-    options: &RetargetOptions,
-) -> Result<Solver<'m>, Error> {
-    let mut solver_options = options.solver.clone();
-    if let SolveMode::Plausible(p) = &options.mode {
-        solver_options.max_extra_steps = p.max_extra_steps;
-        solver_options.arithmetic = crate::solver::Arithmetic::Lean;
-    }
-    let mut solver = Solver::new(model, stages, solver_options)?;
-    if let SolveMode::Plausible(p) = &options.mode {
-        solver.add_constraint(Box::new(Ground::new(model, p.floor)));
-        if p.self_collision == SelfCollisionMode::On {
-            solver.add_constraint(Box::new(SelfCollision::new(model)));
-        }
-        if p.speed_limits == SpeedLimits::Robot {
-            let limits: Vec<Option<f64>> = model.joints.iter().map(|j| j.velocity_limit).collect();
-            solver.set_speed_limits(&limits)?;
-        }
-    }
-    Ok(solver)
 }
 
 /// The `dt` a solve's first frame is solved with: 0, so that no joint speed limit holds

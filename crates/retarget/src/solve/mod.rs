@@ -37,11 +37,12 @@ use mjcf::Model;
 
 pub use banded::{Banded, NotPositiveDefinite};
 pub use dynamics::DynamicsOptions;
-pub(crate) use first_pass::{build_solver, first_frame_dt, solve_first_frame};
+pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
     ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
     SpeedLimits,
 };
+pub(crate) use prepare::build_solver;
 pub use prepare::task_specs;
 pub(crate) use prepare::{finite_pose, reject_divergence};
 pub use reweigh::reweigh;

@@ -12,9 +12,9 @@ use std::ops::Range;
 use mjcf::{JointType, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::first_pass::build_solver;
-use super::{ClipDiagnostics, RetargetOptions, SolveMode};
+use super::{ClipDiagnostics, RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits};
 use crate::config::IkConfig;
+use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
 use crate::lie::Pose;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
@@ -238,6 +238,33 @@ impl crate::solve::trajectory::Frames for Prepared<'_> {
         let body = self.root_body()?;
         Some((self.frame_targets(frame)[self.root_target], body == free.body))
     }
+}
+
+/// The solver of a clip or a stream: GMR's, or with the default mode's constraints (ground,
+/// self-collision, joint speed limits). The one place both [`retarget_motion`](super::retarget_motion) and
+/// [`crate::Retargeter::step`] build it, so that they solve the same problem.
+pub(crate) fn build_solver<'m>(
+    model: &'m Model,
+    stages: &[Vec<TaskSpec>],
+    options: &RetargetOptions,
+) -> Result<Solver<'m>, Error> {
+    let mut solver_options = options.solver.clone();
+    if let SolveMode::Plausible(p) = &options.mode {
+        solver_options.max_extra_steps = p.max_extra_steps;
+        solver_options.arithmetic = crate::solver::Arithmetic::Lean;
+    }
+    let mut solver = Solver::new(model, stages, solver_options)?;
+    if let SolveMode::Plausible(p) = &options.mode {
+        solver.add_constraint(Box::new(Ground::new(model, p.floor)));
+        if p.self_collision == SelfCollisionMode::On {
+            solver.add_constraint(Box::new(SelfCollision::new(model)));
+        }
+        if p.speed_limits == SpeedLimits::Robot {
+            let limits: Vec<Option<f64>> = model.joints.iter().map(|j| j.velocity_limit).collect();
+            solver.set_speed_limits(&limits)?;
+        }
+    }
+    Ok(solver)
 }
 
 /// Active entries of each enabled table as solver tasks; target slots index `map.bodies`.
