@@ -64,7 +64,8 @@ pub struct BatchArgs {
     pub both_ways: bool,
     /// Split clips longer than this many frames into chunks solved in parallel (each warm-
     /// started from a lead-in; on the LAFAN1 walk the result equals the serial solve to
-    /// 3.7e-10 rad with --gmr, 1.1e-4 rad with the default solve).
+    /// 3.7e-10 rad with --gmr; with the default solve each chunk is a trajectory problem
+    /// of its own, within 0.05 rad of the serial solve, median frame 3e-4 rad).
     #[arg(long, value_name = "FRAMES")]
     pub chunk_frames: Option<usize>,
     /// Frames solved before each chunk and thrown away, so that its seam is smooth.
