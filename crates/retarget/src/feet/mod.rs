@@ -63,7 +63,7 @@ use anchors::{foot_anchors, separate, Planted};
 use floor::{floor_shift, keep_feet_apart};
 use math::quat;
 use stance::{plant, roll_shares};
-use swing::swing;
+use swing::{swing, Swing};
 use uncross::uncrossed;
 
 pub use detect::detect_feet;
@@ -120,6 +120,7 @@ pub fn plan_uncrossing(
     let Uncrossing { uncross, heading } = *crossings;
     let frames = targets.len().checked_div(slots).unwrap_or(0);
     let labels = [&contacts.left, &contacts.right];
+    // 1. The floor.
     let shift = floor_shift(feet, &labels, targets, slots, options.clearance);
     for p in targets.iter_mut() {
         p.pos.z += shift;
@@ -127,7 +128,6 @@ pub fn plan_uncrossing(
     if let [Some(left), Some(right)] = feet {
         keep_feet_apart(left, right, targets, slots, options.sole_gap);
     }
-    let lead = (options.lead_s * fps).round().max(0.0) as usize;
     let mut plan = FootPlan {
         shift,
         weight: vec![[1.0; 2]; frames],
@@ -135,19 +135,11 @@ pub fn plan_uncrossing(
         swing_floor: vec![[None; 2]; frames],
         crossed: Vec::new(),
     };
-    // Each foot's stance phases and their anchors, (range, xy, yaw), then kept apart.
-    let mut anchors: [Vec<Planted>; 2] = [Vec::new(), Vec::new()];
-    let mut free_targets: [Vec<Pose>; 2] = [Vec::new(), Vec::new()];
-    // Per foot and frame, the free target's yaw (what a pivot follows).
-    let mut free_yaw: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
-    for (side, foot) in feet.iter().enumerate() {
-        let Some(foot) = foot else { continue };
-        let label = &labels[side][..frames.min(labels[side].len())];
-        let free: Vec<Pose> = (0..frames).map(|t| targets[t * slots + foot.slot]).collect();
-        anchors[side] = foot_anchors(foot, label, &free, targets, slots, lead, options.anchor);
-        free_yaw[side] = free.iter().map(|p| foot.yaw(&quat(p))).collect();
-        free_targets[side] = free;
-    }
+    // 2. Planting: each foot's stance phases and their anchors, kept apart, then the
+    // planted poses; 3. the swing.
+    let lead = (options.lead_s * fps).round().max(0.0) as usize;
+    let Free { targets: free, yaw: free_yaw, mut anchors } =
+        free_feet(feet, &labels, targets, slots, lead, options);
     if let [Some(left), Some(right)] = feet {
         separate(left, right, &mut anchors, options.sole_gap);
         plan.crossed = uncrossed(left, right, &mut anchors, options.sole_gap, uncross, heading);
@@ -156,27 +148,90 @@ pub fn plan_uncrossing(
     let roll_frames = (options.roll_s * fps).round().max(1.0);
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
-        let free = &free_targets[side];
         let roll = roll_shares(&planted_mask[1 - side], roll_frames);
-        let planted = plant(foot, &anchors[side], free, &free_yaw[side], &roll, options);
+        let planted = plant(foot, &anchors[side], &free[side], &free_yaw[side], &roll, options);
+        plan.set_stance(foot, side, &planted, options.stance_weight, targets, slots);
+        let held: Vec<bool> = planted.iter().map(Option::is_some).collect();
+        let swings = swing(foot, &held, &free[side], targets, slots, fps, options);
+        plan.set_swing(foot, side, swings, targets, slots);
+    }
+    plan
+}
+
+/// The feet before planting, per foot (empty where there is none).
+struct Free {
+    /// The free targets, one per frame, as the floor step left them.
+    targets: [Vec<Pose>; 2],
+    /// Their yaws (what a pivot follows).
+    yaw: [Vec<f64>; 2],
+    /// The stance phases with their anchors.
+    anchors: [Vec<Planted>; 2],
+}
+
+/// The [`Free`] feet of `targets` (`frames × slots`), with the stance phases of `labels`
+/// begun `lead` frames early.
+fn free_feet(
+    feet: &[Option<RobotFoot>; 2],
+    labels: &[&Vec<bool>; 2],
+    targets: &[Pose],
+    slots: usize,
+    lead: usize,
+    options: &FootPlanOptions,
+) -> Free {
+    let frames = targets.len().checked_div(slots).unwrap_or(0);
+    let mut free: [Vec<Pose>; 2] = Default::default();
+    let mut free_yaw: [Vec<f64>; 2] = Default::default();
+    let mut anchors: [Vec<Planted>; 2] = Default::default();
+    for (side, foot) in feet.iter().enumerate() {
+        let Some(foot) = foot else { continue };
+        let label = &labels[side][..frames.min(labels[side].len())];
+        let own: Vec<Pose> = (0..frames).map(|t| targets[t * slots + foot.slot]).collect();
+        anchors[side] = foot_anchors(foot, label, &own, targets, slots, lead, options.anchor);
+        free_yaw[side] = own.iter().map(|p| foot.yaw(&quat(p))).collect();
+        free[side] = own;
+    }
+    Free { targets: free, yaw: free_yaw, anchors }
+}
+
+impl FootPlan {
+    /// Writes `foot`'s `planted` poses (per frame, `None` out of stance) into `targets` and
+    /// their sole points and `weight` into the plan.
+    fn set_stance(
+        &mut self,
+        foot: &RobotFoot,
+        side: usize,
+        planted: &[Option<Pose>],
+        weight: f64,
+        targets: &mut [Pose],
+        slots: usize,
+    ) {
         for (t, pose) in planted.iter().enumerate() {
             let Some(pose) = pose else { continue };
-            plan.contact[t][side] = foot.contact_points(pose, 1.0);
+            self.contact[t][side] = foot.contact_points(pose, 1.0);
             targets[t * slots + foot.slot] = *pose;
-            plan.weight[t][side] = options.stance_weight;
+            self.weight[t][side] = weight;
         }
-        let held: Vec<bool> = planted.iter().map(Option::is_some).collect();
-        let swings = swing(foot, &held, free, targets, slots, fps, options);
+    }
+
+    /// Writes `foot`'s `swings` (per frame, `None` in stance) into the plan and its raised
+    /// targets into `targets`.
+    fn set_swing(
+        &mut self,
+        foot: &RobotFoot,
+        side: usize,
+        swings: Vec<Option<Swing>>,
+        targets: &mut [Pose],
+        slots: usize,
+    ) {
         for (t, s) in swings.into_iter().enumerate() {
             let Some(s) = s else { continue };
-            plan.contact[t][side] = s.held;
-            plan.swing_floor[t][side] = s.floor;
+            self.contact[t][side] = s.held;
+            self.swing_floor[t][side] = s.floor;
             if let Some(pose) = s.target {
                 targets[t * slots + foot.slot] = pose;
             }
         }
     }
-    plan
 }
 
 /// Per frame, whether any of the stance `phases` covers it.
