@@ -172,9 +172,8 @@ use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, Bod
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReportOptions {
-    /// Foot bodies `[left, right]`; `None`: `left_ankle_roll_link` / `right_ankle_roll_link`
-    /// if the model has them, else on each side the lowest body (at `qpos0`) whose name has
-    /// `ankle` or `foot` and a side marker (`left`, `l_`, `_l`; `right`, `r_`, `_r`).
+    /// Foot bodies `[left, right]`; `None`: the feet the default solve plants
+    /// ([`crate::feet::detect_feet`]).
     pub feet: Option<[String; 2]>,
     /// Height of the ground plane (m). Default 0.
     pub ground_height: f64,
@@ -470,7 +469,7 @@ pub fn report(
     }
     let feet = match &opts.feet {
         Some([l, r]) => [named_body(model, l)?, named_body(model, r)?],
-        None => detect_feet(model)?,
+        None => crate::feet::detect_feet(model)?,
     };
     let poses = body_poses(motion, model);
     let frames = motion.num_frames();
@@ -682,60 +681,6 @@ fn named_body(model: &mjcf::Model, name: &str) -> Result<usize, Error> {
         .body_id(name)
         .filter(|&b| b > 0)
         .ok_or_else(|| Error::Options(format!("no body named \"{name}\" in the robot model")))
-}
-
-/// The two foot bodies `[left, right]` (see [`ReportOptions::feet`]): by name, else the
-/// robot recogniser's ([`crate::RobotRoles`]) feet.
-pub fn detect_feet(model: &mjcf::Model) -> Result<[usize; 2], Error> {
-    if let (Some(l), Some(r)) =
-        (model.body_id("left_ankle_roll_link"), model.body_id("right_ankle_roll_link"))
-    {
-        return Ok([l, r]);
-    }
-    // The robots in `robots/` mark their soles with geoms named `left_sole` / `right_sole`.
-    if let (Some(l), Some(r)) = (model.geom_id("left_sole"), model.geom_id("right_sole")) {
-        return Ok([model.geoms[l].body, model.geoms[r].body]);
-    }
-    let mut data = mjcf::Data::new(model);
-    model.kinematics(&model.qpos0, &mut data);
-    let side = |markers: [&str; 3], prefix: &str| {
-        let candidates = model.bodies.iter().enumerate().skip(1).filter(|(_, b)| {
-            let n = b.name.to_ascii_lowercase();
-            (n.contains("ankle") || n.contains("foot"))
-                && (n.contains(markers[0])
-                    || n.starts_with(prefix)
-                    || n.contains(markers[1])
-                    || n.ends_with(markers[2]))
-        });
-        // Lowest at qpos0; the later (deeper) body on ties.
-        candidates
-            .map(|(i, _)| i)
-            .min_by(|&a, &b| data.xpos[a].z.total_cmp(&data.xpos[b].z).then(b.cmp(&a)))
-    };
-    let recognised =
-        crate::robot_roles::RobotRoles::recognise(model).map(|roles| roles.soles.map(|s| s.body));
-    match (side(["left", "_l_", "_l"], "l_"), side(["right", "_r_", "_r"], "r_"), recognised) {
-        // A named body above the recognised foot is an ankle link between the shin and the
-        // foot (Adam Lite's `anklePitchLeft`, over its `toeLeft`): the foot is the recognised
-        // one. (Planting that ankle link planted the shin, its tracked ancestor.)
-        (Some(l), Some(r), Ok([rl, rr])) if l != r => {
-            let foot = |named: usize, found: usize| {
-                if crate::feet::is_descendant(model, found, named) {
-                    found
-                } else {
-                    named
-                }
-            };
-            Ok([foot(l, rl), foot(r, rr)])
-        }
-        (Some(l), Some(r), Err(_)) if l != r => Ok([l, r]),
-        // Names say nothing: the robot recogniser's feet (tree and geometry).
-        (_, _, Ok(found)) => Ok(found),
-        (_, _, Err(e)) => Err(Error::Options(format!(
-            "cannot find the two foot bodies by name (ankle/foot, left/right) nor by \
-             recognising the robot ({e}): name them"
-        ))),
-    }
 }
 
 /// What a foot's height is measured at ([`FootReport::height_from`]).

@@ -4,7 +4,8 @@
 mod shared;
 
 use nalgebra::Vector3;
-use retarget::report::{detect_feet, report, ReportOptions};
+use retarget::feet::detect_feet;
+use retarget::report::{report, ReportOptions};
 use retarget::{FootContacts, RobotMotion, TrackedTargets};
 
 const FPS: f64 = 30.0;

@@ -105,10 +105,10 @@ impl<'a> Prepared<'a> {
     }
 }
 
-/// The robot's two feet (sole bodies, as the report finds them) with the task that moves
+/// The robot's two feet (sole bodies, [`crate::feet::detect_feet`]) with the task that moves
 /// each: a task on the sole body itself, else on its nearest ancestor that has one.
 fn robot_feet(model: &Model, stages: &[Vec<TaskSpec>]) -> [Option<RobotFoot>; 2] {
-    let Ok(soles) = crate::report::detect_feet(model) else {
+    let Ok(soles) = crate::feet::detect_feet(model) else {
         return [None, None];
     };
     // The nearest body at or above `from` that has a task, with that task's target slot.

@@ -1,0 +1,105 @@
+//! The sole of a foot without collision geometry: the equivalent inertia box of a body at or
+//! below it ([`inertia_sole`]).
+
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: body ids come from the model.
+#![allow(clippy::indexing_slicing)]
+
+use mjcf::{Data, Model};
+use nalgebra::{Isometry3, Translation3};
+
+use super::tree::is_descendant;
+
+/// Shortest and longest plausible half length (m) of a foot's equivalent inertia box
+/// ([`inertia_sole`]).
+const INERTIA_SOLE_HALF_LENGTH: [f64; 2] = [0.03, 0.2];
+
+/// A sole for a foot without collision geometry (the motion-capture models of the N1, the
+/// H1, the H1-2, the Hi have bodies with masses and nothing else): the uniform box with the
+/// mass and principal moments of a body at or below the foot ([`inertia_sole`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InertiaSole {
+    pub body: usize,
+    /// Half sizes along the principal axes (m).
+    pub half: [f64; 3],
+    /// The box's pose in `body`'s frame: centre of mass and principal axes.
+    pub pose: Isometry3<f64>,
+}
+
+impl InertiaSole {
+    /// The box's world pose with `data`'s kinematics.
+    pub fn world(&self, data: &Data) -> Isometry3<f64> {
+        let body = Translation3::from(data.xpos[self.body]);
+        Isometry3::from_parts(body, data.xquat[self.body]) * self.pose
+    }
+}
+
+/// The [`InertiaSole`] of the heaviest body at or below `sole_body` whose box has a foot's
+/// length ([`INERTIA_SOLE_HALF_LENGTH`] for its longest half side). The N1's foot gives
+/// 19 × 6.8 × 3.4 cm with its bottom 4.9 cm below the ankle axis; a real sole's mass sits
+/// higher than its middle (motors, ankle), so the box's bottom is a little above the real
+/// sole, which the floor shift of [`super::plan`] takes up. `None` when no body there has an
+/// inertial.
+pub(crate) fn inertia_sole(model: &Model, sole_body: usize) -> Option<InertiaSole> {
+    (0..model.bodies.len())
+        .filter(|&b| is_descendant(model, b, sole_body))
+        .filter_map(|b| {
+            let inertial = model.bodies[b].inertial?;
+            let half = inertial.equivalent_box()?;
+            let [shortest, longest] = INERTIA_SOLE_HALF_LENGTH;
+            let long = half.max();
+            (long >= shortest && long <= longest).then_some((b, inertial, half))
+        })
+        .max_by(|a, b| a.1.mass.total_cmp(&b.1.mass))
+        .map(|(body, inertial, half)| InertiaSole {
+            body,
+            half: [half.x, half.y, half.z],
+            pose: Isometry3::from_parts(Translation3::from(inertial.pos), inertial.quat),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    use super::*;
+    use crate::feet::RobotFoot;
+
+    #[test]
+    fn a_foot_without_geoms_stands_on_its_inertia_box() {
+        // The N1 motion-capture model's foot: no geoms, 0.528 kg, centre of mass 3.1 cm ahead
+        // of and 3.2 cm below the ankle, principal moments giving a 19.2 × 6.8 × 3.4 cm box
+        // (long axis along the principal z, turned onto the body's x).
+        let xml = r#"<mujoco><worldbody><body name="foot" pos="0 0 0.05"><freejoint/>
+            <body name="toe"/></body></worldbody></mujoco>"#;
+        let mut model = Model::from_xml_str(xml, None).unwrap();
+        let inertial = mjcf::Inertial {
+            mass: 0.528,
+            pos: Vector3::new(0.031, 0.0, -0.032),
+            quat: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2),
+            diag: Vector3::new(0.00183246, 0.00168042, 0.000253637),
+        };
+        model.bodies[1].inertial = Some(inertial);
+        let foot = RobotFoot::new(&model, 1, 1, 0, None).unwrap();
+        let half = inertial.equivalent_box().unwrap();
+        assert!((half.z - 0.096).abs() < 1e-3 && (half.x - 0.017).abs() < 1e-3, "{half:?}");
+        // Four bottom corners, 1.7 cm under the centre of mass, 9.6 cm ahead and behind it.
+        assert_eq!(foot.corners.len(), 4);
+        for c in &foot.corners {
+            assert!((c.z - (-0.032 - half.x)).abs() < 1e-9, "{c:?}");
+            assert!(((c.x - 0.031).abs() - half.z).abs() < 1e-9, "{c:?}");
+        }
+        assert!((foot.sole_offset(&UnitQuaternion::identity()) + 0.032 + half.x).abs() < 1e-9);
+        // A body with no mass, or a box no foot is (a point mass, a 1 m beam), is no sole.
+        model.bodies[1].inertial = Some(mjcf::Inertial { mass: 0.0, ..inertial });
+        assert!(RobotFoot::new(&model, 1, 1, 0, None).is_none());
+        model.bodies[1].inertial =
+            Some(mjcf::Inertial { diag: Vector3::new(0.0440, 0.0440, 1e-5), ..inertial });
+        assert!(RobotFoot::new(&model, 1, 1, 0, None).is_none());
+        // The heaviest plausible body below the foot is taken.
+        model.bodies[1].inertial = None;
+        model.bodies[2].inertial = Some(inertial);
+        let toe = RobotFoot::new(&model, 1, 1, 0, None).unwrap();
+        assert_eq!(toe.corners.len(), 4);
+    }
+}

@@ -1,0 +1,160 @@
+//! Standing: a planted foot stands on its whole sole ([`RobotFoot::within_band`]) except in
+//! double support, where it rolls with the human's (heel strike, toe off: `roll_shares`); a
+//! pivot's foot turns with the source's about its toe; the planted pose rests the sole's
+//! lowest point on the floor at the anchor (`planted_pose`).
+
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact
+// labels' lengths, which `plan` clips to it.
+#![allow(clippy::indexing_slicing)]
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+use super::anchors::{anchored, pivot, turn_of, Planted};
+use super::math::{quat, smoothstep};
+use super::options::FootPlanOptions;
+use super::soles::RobotFoot;
+use crate::lie::Pose;
+
+/// Rescalings of a planted foot's tilt in [`RobotFoot::within_band`]: the spread of the sole's
+/// bottom points grows about linearly with the tilt's angle, so a few settle it.
+const BAND_RESCALINGS: usize = 4;
+
+impl RobotFoot {
+    /// `rot` with its tilt (from standing flat at its yaw) scaled down until the sole's
+    /// bottom points are within `band` (m) of each other in height: a planted foot stands
+    /// on its whole sole (the dynamics check counts the points within 1 cm of the floor as
+    /// its support).
+    #[must_use]
+    pub fn within_band(&self, rot: &UnitQuaternion<f64>, band: f64) -> UnitQuaternion<f64> {
+        let flat = self.flat(self.yaw(rot));
+        let tilt = flat.inverse() * rot;
+        let spread = |q: &UnitQuaternion<f64>| {
+            let z = self.corners.iter().map(|c| (q * c).z);
+            let (lo, hi) =
+                z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+            hi - lo
+        };
+        let rest = spread(&flat);
+        if self.corners.len() < 2 || spread(rot) - rest <= band {
+            return *rot;
+        }
+        let mut share = 1.0;
+        for _ in 0..BAND_RESCALINGS {
+            let at = flat * UnitQuaternion::identity().slerp(&tilt, share);
+            let over = spread(&at) - rest;
+            if over <= band {
+                break;
+            }
+            share *= band / over;
+        }
+        flat * UnitQuaternion::identity().slerp(&tilt, share)
+    }
+}
+
+/// Per frame, how far a planted foot may roll as the human's does (1) or stands on its whole
+/// sole (0): only while the other foot stands too (`other`, per frame), fading in and out over
+/// `roll_frames` at the double support's ends.
+pub(super) fn roll_shares(other: &[bool], roll_frames: f64) -> Vec<f64> {
+    let frames = other.len();
+    (0..frames)
+        .map(|t| {
+            if !other[t] {
+                return 0.0;
+            }
+            let since = (0..=t).rev().take_while(|&u| other[u]).count() as f64;
+            let until = (t..frames).take_while(|&u| other[u]).count() as f64;
+            smoothstep((since.min(until) / roll_frames).min(1.0))
+        })
+        .collect()
+}
+
+/// Per frame, the planted pose of `foot` in its stance `phases` (`None` out of stance): the
+/// flat foot at the phase's anchor (a pivot's turned with the source's yaw, `free_yaw`, about
+/// its toe), tilted as the `free` target within [`FootPlanOptions::sole_band`], rolled by
+/// `roll` towards the free target's tilt, resting at [`FootPlanOptions::clearance`].
+pub(super) fn plant(
+    foot: &RobotFoot,
+    phases: &[Planted],
+    free: &[Pose],
+    free_yaw: &[f64],
+    roll: &[f64],
+    options: &FootPlanOptions,
+) -> Vec<Option<Pose>> {
+    let mut planted = vec![None; free.len()];
+    for (r, xy, yaw) in phases {
+        let (xy, yaw) = (*xy, *yaw);
+        let pivots = turn_of(&free_yaw[r.clone()], yaw) > options.pivot_turn;
+        for t in r.clone() {
+            let (xy, yaw) =
+                if pivots { (pivot(foot, xy, yaw, free_yaw[t]), free_yaw[t]) } else { (xy, yaw) };
+            let tilt = quat(&free[t]);
+            let q = foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t]);
+            let rolled = Pose { quat: [q.w, q.i, q.j, q.k], pos: free[t].pos };
+            planted[t] = Some(planted_pose(foot, &rolled, xy, yaw, options.clearance));
+        }
+    }
+    planted
+}
+
+/// The planted pose: the free target's tilt with the anchor's yaw, rolled over the sole's
+/// lowest point, which stays where it is on the flat foot at the anchor and rests at
+/// `clearance` above the floor.
+pub(super) fn planted_pose(
+    foot: &RobotFoot,
+    free: &Pose,
+    anchor: Vector3<f64>,
+    yaw: f64,
+    clearance: f64,
+) -> Pose {
+    let q = anchored(foot, free, yaw);
+    let flat = foot.flat(yaw);
+    let low = foot.sole_low_point(&q);
+    let contact = Vector3::new(anchor.x, anchor.y, 0.0) + flat * low;
+    let rolled = q * low;
+    let pos = Vector3::new(contact.x - rolled.x, contact.y - rolled.y, clearance - rolled.z);
+    Pose { quat: [q.w, q.i, q.j, q.k], pos }
+}
+
+#[cfg(test)]
+mod tests {
+    use mjcf::GeomType;
+    use nalgebra::Isometry3;
+
+    use super::*;
+    use crate::feet::plan;
+    use crate::feet::soles::fixtures::box_foot;
+    use crate::motion::FootContacts;
+
+    /// A planted foot whose human foot stands 10° toes-down: alone on the floor it stands
+    /// on its whole sole (corners within the band); while the other foot stands too, it
+    /// rolls with the human's.
+    #[test]
+    fn a_foot_alone_on_the_floor_stands_on_its_whole_sole() {
+        let options = FootPlanOptions::default();
+        let mut foot = box_foot();
+        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+        let fps = 30.0;
+        let frames = 60;
+        let toes_down = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.17);
+        let q = toes_down.quaternion();
+        let tilted = Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.0, 0.0, 0.05) };
+        let beside = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(0.0, 0.3, 0.02) };
+        let mut targets: Vec<Pose> = (0..frames).flat_map(|_| [tilted, beside]).collect();
+        // The right foot stands in the second half only.
+        let contacts = FootContacts {
+            left: vec![true; frames],
+            right: (0..frames).map(|t| t >= 30).collect(),
+        };
+        let feet = [Some(foot.clone()), Some(RobotFoot { slot: 1, ..foot.clone() })];
+        plan(&feet, &contacts, &mut targets, 2, fps, &options);
+        let spread = |p: &Pose| {
+            let z: Vec<f64> = foot.corners.iter().map(|c| (quat(p) * c).z).collect();
+            z.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - z.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        assert!(spread(&targets[10 * 2]) <= options.sole_band + 1e-9, "{}", spread(&targets[20]));
+        // Deep in the double support: the human's 10°, its corners 3.5 cm apart in height.
+        assert!(spread(&targets[45 * 2]) > 0.03, "{}", spread(&targets[90]));
+    }
+}
