@@ -455,17 +455,9 @@ pub(crate) fn inertia_sole(model: &Model, sole_body: usize) -> Option<InertiaSol
         })
 }
 
-/// Whether `body` is `ancestor` or one of the bodies below it.
-pub(crate) fn is_descendant(model: &Model, mut body: usize, ancestor: usize) -> bool {
-    loop {
-        if body == ancestor {
-            return true;
-        }
-        if body == 0 {
-            return false;
-        }
-        body = model.bodies[body].parent;
-    }
+/// Whether `body` is `ancestor` or one of the bodies below it ([`Model::is_ancestor_or_self`]).
+pub(crate) fn is_descendant(model: &Model, body: usize, ancestor: usize) -> bool {
+    model.is_ancestor_or_self(ancestor, body)
 }
 
 fn pose_of(pos: &Vector3<f64>, mat: &Matrix3<f64>) -> Isometry3<f64> {
