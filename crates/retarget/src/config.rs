@@ -536,6 +536,41 @@ mod tests {
         assert_eq!(near[0], "LeftFoot");
     }
 
+    /// Written in GMR's layout (a row a line, decimals without exponents), and read back
+    /// exactly.
+    #[test]
+    fn the_file_form_is_written_in_gmrs_layout() {
+        let file: ConfigFile = serde_json::from_str(SMALL).unwrap();
+        let mut tiny = file.clone();
+        tiny.ik_match_table1.0[0].1 .3 = [3e-9, -0.25, 1.0 / 3.0];
+        let c = IkConfig::from_file_form(tiny, "t.json").unwrap();
+        let want = r#"{
+  "robot_root_name": "a",
+  "human_root_name": "Hips",
+  "ground_height": 0.0,
+  "human_height_assumption": 1.8,
+  "use_ik_match_table1": true,
+  "use_ik_match_table2": false,
+  "human_scale_table": {
+    "Hips": 0.9,
+    "Spine": 0.8
+  },
+  "ik_match_table1": {
+    "b": ["Spine", 1.0, 2.0, [0.000000003, -0.25, 0.3333333333333333], [1.0, 0.0, 0.0, 0.0]],
+    "a": ["Hips", 0.0, 10.0, [0.1, 0.0, 0.0], [0.5, 0.5, 0.5, 0.5]]
+  },
+  "ik_match_table2": {
+  }
+}
+"#;
+        assert_eq!(c.json(), want);
+        assert_eq!(IkConfig::from_json_str(want, "t.json").unwrap(), c);
+        let mut twice = file;
+        twice.ik_match_table1.0[1].0 = "b".to_owned();
+        let err = IkConfig::from_file_form(twice, "t.json").unwrap_err().to_string();
+        assert!(err.contains("duplicate key `b`"), "{err}");
+    }
+
     #[test]
     fn locate_finds_line_and_column() {
         let c = IkConfig::from_json_str(SMALL, "t.json").unwrap();
