@@ -10,7 +10,7 @@
 //!
 //! Table order is kept as written (it decides the order of the tasks and so the
 //! floating-point sums of the solver); configs we write ([`crate::derive`]) are laid out as
-//! GMR's files are, one table row a line ([`ConfigFile`]). Syntax and type errors carry `file:line:column` from
+//! GMR's files are, one table row a line. Syntax and type errors carry `file:line:column` from
 //! serde_json; names that exist in neither the robot nor the human skeleton are reported by
 //! [`IkConfig::validate`] with the position of the name in the file and the nearest names.
 
