@@ -283,6 +283,37 @@ impl Model {
         std::iter::successors(start, |&d| self.dof_parent.get(d).copied().flatten())
     }
 
+    /// `body` and every body below it, breadth first: the body, its children, their children,
+    /// each generation in body order. Empty for a body that does not exist.
+    #[must_use]
+    pub fn subtree(&self, body: usize) -> Vec<usize> {
+        if body >= self.bodies.len() {
+            return Vec::new();
+        }
+        let mut out = vec![body];
+        let mut next = 0;
+        while let Some(&b) = out.get(next) {
+            let children = self.bodies.iter().enumerate().skip(1).filter(|(_, c)| c.parent == b);
+            out.extend(children.map(|(c, _)| c));
+            next += 1;
+        }
+        out
+    }
+
+    /// The bodies above `body`, its parent first and the world (0) last; none for the world
+    /// or a body that does not exist.
+    pub fn ancestors(&self, body: usize) -> impl Iterator<Item = usize> + '_ {
+        let parent = |b: usize| self.bodies.get(b).map(|x| x.parent).filter(|_| b != 0);
+        // A tree is at most `nbody` deep: the bound keeps a malformed parent loop finite.
+        std::iter::successors(parent(body), move |&b| parent(b)).take(self.bodies.len())
+    }
+
+    /// Whether `ancestor` is `body` or one of the bodies above it (the world is everyone's).
+    #[must_use]
+    pub fn is_ancestor_or_self(&self, ancestor: usize, body: usize) -> bool {
+        ancestor == body || self.ancestors(body).any(|b| b == ancestor)
+    }
+
     /// The joint a dof belongs to. Panics if `dof >= nv`.
     #[must_use]
     // A caller's out-of-range dof is a bug, like slice indexing (documented above).
@@ -451,5 +482,63 @@ impl Model {
         self.nq = nq;
         self.nv = nv;
         self.jnt_pos_zero = self.joints.iter().map(|j| j.pos == Vector3::zeros()).collect();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// world ─ torso ─┬─ left ─ left_foot
+    ///                ├─ right ─ right_foot
+    ///                └─ head
+    const TREE: &str = r#"<mujoco><worldbody>
+      <body name="torso"><freejoint/><geom size="0.1"/>
+        <body name="left"><geom size="0.1"/><body name="left_foot"><geom size="0.1"/></body></body>
+        <body name="right"><geom size="0.1"/><body name="right_foot"><geom size="0.1"/></body></body>
+        <body name="head"><geom size="0.1"/></body>
+      </body>
+      <body name="other"><geom size="0.1"/></body>
+    </worldbody></mujoco>"#;
+
+    fn ids(model: &Model, names: &[&str]) -> Vec<usize> {
+        names.iter().map(|n| model.body_id(n).unwrap()).collect()
+    }
+
+    #[test]
+    fn subtree_is_breadth_first_with_each_generation_in_body_order() {
+        let m = Model::from_xml_str(TREE, None).unwrap();
+        let torso = m.body_id("torso").unwrap();
+        let want = ids(&m, &["torso", "left", "right", "head", "left_foot", "right_foot"]);
+        assert_eq!(m.subtree(torso), want);
+        let foot = m.body_id("left_foot").unwrap();
+        assert_eq!(m.subtree(foot), vec![foot]);
+        assert_eq!(m.subtree(0).len(), m.nbody());
+        assert!(m.subtree(m.nbody()).is_empty());
+    }
+
+    #[test]
+    fn ancestors_run_from_the_parent_to_the_world() {
+        let m = Model::from_xml_str(TREE, None).unwrap();
+        let foot = m.body_id("right_foot").unwrap();
+        let want = ids(&m, &["right", "torso"]).into_iter().chain([0]).collect::<Vec<_>>();
+        assert_eq!(m.ancestors(foot).collect::<Vec<_>>(), want);
+        assert_eq!(m.ancestors(0).count(), 0);
+        assert_eq!(m.ancestors(m.nbody()).count(), 0);
+    }
+
+    #[test]
+    fn is_ancestor_or_self_follows_the_parents_only() {
+        let m = Model::from_xml_str(TREE, None).unwrap();
+        let [torso, left, foot, right, other] =
+            ["torso", "left", "left_foot", "right", "other"].map(|n| m.body_id(n).unwrap());
+        assert!(m.is_ancestor_or_self(torso, foot));
+        assert!(m.is_ancestor_or_self(left, foot));
+        assert!(m.is_ancestor_or_self(foot, foot));
+        assert!(m.is_ancestor_or_self(0, foot));
+        assert!(!m.is_ancestor_or_self(foot, left));
+        assert!(!m.is_ancestor_or_self(right, foot));
+        assert!(!m.is_ancestor_or_self(other, foot));
+        assert!(!m.is_ancestor_or_self(torso, 0));
     }
 }

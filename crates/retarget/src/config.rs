@@ -9,7 +9,8 @@
 //! ```
 //!
 //! Table order is kept as written (it decides the order of the tasks and so the
-//! floating-point sums of the solver). Syntax and type errors carry `file:line:column` from
+//! floating-point sums of the solver); configs we write ([`crate::derive`]) are laid out as
+//! GMR's files are, one table row a line. Syntax and type errors carry `file:line:column` from
 //! serde_json; names that exist in neither the robot nor the human skeleton are reported by
 //! [`IkConfig::validate`] with the position of the name in the file and the nearest names.
 
@@ -21,7 +22,8 @@ use std::path::Path;
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
-use serde::Deserialize;
+use serde::ser::{SerializeMap, Serializer};
+use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
@@ -67,41 +69,60 @@ pub struct IkConfig {
     text: String,
 }
 
-#[derive(Deserialize)]
+/// A config file as GMR's schema writes it: what [`IkConfig::from_json_str`] reads and
+/// [`IkConfig::from_file_form`] writes, fields in GMR's order.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
-struct RawConfig {
-    robot_root_name: String,
-    human_root_name: String,
-    ground_height: f64,
-    human_height_assumption: f64,
-    use_ik_match_table1: bool,
-    use_ik_match_table2: bool,
-    human_scale_table: Ordered<f64>,
-    ik_match_table1: Ordered<RawEntry>,
-    ik_match_table2: Ordered<RawEntry>,
+pub(crate) struct ConfigFile {
+    pub(crate) robot_root_name: String,
+    pub(crate) human_root_name: String,
+    pub(crate) ground_height: f64,
+    pub(crate) human_height_assumption: f64,
+    pub(crate) use_ik_match_table1: bool,
+    pub(crate) use_ik_match_table2: bool,
+    pub(crate) human_scale_table: Ordered<f64>,
+    pub(crate) ik_match_table1: Ordered<FileEntry>,
+    pub(crate) ik_match_table2: Ordered<FileEntry>,
     /// GMR reads it (initial joint values); accepted, not used yet.
-    #[serde(default)]
-    #[allow(dead_code)]
-    robot_initial_qpos: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) robot_initial_qpos: Option<serde_json::Value>,
     /// Marker-driven configs (`retarget --c3d`): read by the CLI, ignored here.
-    #[serde(default)]
-    #[allow(dead_code)]
-    marker_bodies: Option<serde_json::Value>,
-    #[serde(default)]
-    #[allow(dead_code)]
-    source_axes: Option<serde_json::Value>,
-    #[serde(default)]
-    #[allow(dead_code)]
-    marker_units_m: Option<serde_json::Value>,
-    #[serde(default)]
-    #[allow(dead_code)]
-    marker_height: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) marker_bodies: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) source_axes: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) marker_units_m: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) marker_height: Option<serde_json::Value>,
 }
 
-type RawEntry = (String, f64, f64, [f64; 3], [f64; 4]);
+/// A table row as written: `"body": ["joint", pos_weight, rot_weight, [x, y, z], [w, x, y, z]]`.
+pub(crate) type FileEntry = (String, f64, f64, [f64; 3], [f64; 4]);
 
-/// A JSON object read as a list of pairs in file order (duplicate keys are an error).
-struct Ordered<T>(Vec<(String, T)>);
+/// A JSON object as a list of pairs in file order (duplicate keys are an error when read).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Ordered<T>(pub(crate) Vec<(String, T)>);
+
+impl<T: Serialize> Serialize for Ordered<T> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut map = serializer.serialize_map(Some(self.0.len()))?;
+        for (key, value) in &self.0 {
+            map.serialize_entry(key, value)?;
+        }
+        map.end()
+    }
+}
+
+impl<T> Ordered<T> {
+    /// The first key that occurs twice.
+    fn duplicate(&self) -> Option<&str> {
+        let keys = self.0.iter().map(|(k, _)| k.as_str());
+        keys.clone()
+            .enumerate()
+            .find_map(|(i, k)| keys.clone().take(i).any(|o| o == k).then_some(k))
+    }
+}
 
 impl<'de, T: Deserialize<'de>> Deserialize<'de> for Ordered<T> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
@@ -136,11 +157,34 @@ impl IkConfig {
 
     /// Parses config text; `source` names it in errors (a path, or e.g. `<embedded>`).
     pub fn from_json_str(text: &str, source: &str) -> Result<IkConfig, Error> {
-        let raw: RawConfig = serde_json::from_str(text).map_err(|e| Error::Config {
+        let raw: ConfigFile = serde_json::from_str(text).map_err(|e| Error::Config {
             at: format!("{source}:{}:{}", e.line(), e.column()),
             message: strip_position(&e.to_string()),
         })?;
-        let entries = |table: Ordered<RawEntry>| -> Vec<MatchEntry> {
+        Self::from_parts(raw, text.to_owned(), source)
+    }
+
+    /// The config that `file` says, with `file` written in GMR's layout as its text
+    /// ([`IkConfig::json`]): the same config as reading that text, without reading it (the
+    /// numbers are written exactly, so the text reads back to `file`).
+    pub(crate) fn from_file_form(file: ConfigFile, source: &str) -> Result<IkConfig, Error> {
+        let tables = [&file.ik_match_table1, &file.ik_match_table2];
+        let duplicate = file.human_scale_table.duplicate();
+        if let Some(key) = duplicate.or_else(|| tables.iter().find_map(|t| t.duplicate())) {
+            return Err(Error::Config {
+                at: source.to_owned(),
+                message: format!("duplicate key `{key}`"),
+            });
+        }
+        let text = gmr_layout(&file).map_err(|e| Error::Config {
+            at: source.to_owned(),
+            message: format!("cannot write the config: {e}"),
+        })?;
+        Self::from_parts(file, text, source)
+    }
+
+    fn from_parts(raw: ConfigFile, text: String, source: &str) -> Result<IkConfig, Error> {
+        let entries = |table: Ordered<FileEntry>| -> Vec<MatchEntry> {
             table.0.into_iter().map(|(robot_body, e)| entry(robot_body, e)).collect()
         };
         let config = IkConfig {
@@ -154,7 +198,7 @@ impl IkConfig {
             human_scale_table: raw.human_scale_table.0,
             ik_match_table1: entries(raw.ik_match_table1),
             ik_match_table2: entries(raw.ik_match_table2),
-            text: text.to_owned(),
+            text,
         };
         config.check_numbers()?;
         Ok(config)
@@ -324,7 +368,7 @@ impl IkConfig {
     }
 }
 
-fn entry(robot_body: String, (human_body, pos_weight, rot_weight, p, q): RawEntry) -> MatchEntry {
+fn entry(robot_body: String, (human_body, pos_weight, rot_weight, p, q): FileEntry) -> MatchEntry {
     MatchEntry {
         robot_body,
         human_body,
@@ -333,6 +377,74 @@ fn entry(robot_body: String, (human_body, pos_weight, rot_weight, p, q): RawEntr
         pos_offset: Vector3::new(p[0], p[1], p[2]),
         // As written: GMR hands these to scipy, which normalises; we normalise too.
         rot_offset: UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3])),
+    }
+}
+
+/// `file` as JSON in the layout of GMR's config files: an object a line per key (two spaces
+/// of indent a level), a table row on one line, numbers as decimals without an exponent.
+fn gmr_layout(file: &ConfigFile) -> Result<String, serde_json::Error> {
+    let mut out = Vec::new();
+    file.serialize(&mut serde_json::Serializer::with_formatter(&mut out, GmrLayout::default()))?;
+    out.push(b'\n');
+    // serde_json writes UTF-8 only.
+    Ok(String::from_utf8_lossy(&out).into_owned())
+}
+
+/// serde_json's pretty layout for objects, its compact one (with a space after each comma)
+/// inside arrays, so a table row stays on one line as in GMR's files; numbers in Rust's
+/// shortest round-trip decimal form (`0.000000003`, `100.0`), which reads back exactly.
+#[derive(Default)]
+struct GmrLayout {
+    /// Objects open around the value being written.
+    depth: usize,
+}
+
+impl GmrLayout {
+    fn indent<W: ?Sized + std::io::Write>(&self, w: &mut W) -> std::io::Result<()> {
+        (0..self.depth).try_for_each(|_| w.write_all(b"  "))
+    }
+}
+
+impl serde_json::ser::Formatter for GmrLayout {
+    fn write_f64<W: ?Sized + std::io::Write>(&mut self, w: &mut W, v: f64) -> std::io::Result<()> {
+        if v.fract() == 0.0 && v.abs() < 1e15 {
+            write!(w, "{v:.1}")
+        } else {
+            write!(w, "{v}")
+        }
+    }
+
+    fn begin_array_value<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        w.write_all(if first { b"" } else { b", " })
+    }
+
+    fn begin_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.depth += 1;
+        w.write_all(b"{")
+    }
+
+    fn end_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.depth -= 1;
+        w.write_all(b"\n")?;
+        self.indent(w)?;
+        w.write_all(b"}")
+    }
+
+    fn begin_object_key<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        w.write_all(if first { b"\n" } else { b",\n" })?;
+        self.indent(w)
+    }
+
+    fn begin_object_value<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        w.write_all(b": ")
     }
 }
 
@@ -422,6 +534,41 @@ mod tests {
         assert_eq!(edit_distance("", "abc"), 3);
         let near = nearest("LeftFot", &["LeftFoot".into(), "RightFoot".into(), "Hips".into()]);
         assert_eq!(near[0], "LeftFoot");
+    }
+
+    /// Written in GMR's layout (a row a line, decimals without exponents), and read back
+    /// exactly.
+    #[test]
+    fn the_file_form_is_written_in_gmrs_layout() {
+        let file: ConfigFile = serde_json::from_str(SMALL).unwrap();
+        let mut tiny = file.clone();
+        tiny.ik_match_table1.0[0].1 .3 = [3e-9, -0.25, 1.0 / 3.0];
+        let c = IkConfig::from_file_form(tiny, "t.json").unwrap();
+        let want = r#"{
+  "robot_root_name": "a",
+  "human_root_name": "Hips",
+  "ground_height": 0.0,
+  "human_height_assumption": 1.8,
+  "use_ik_match_table1": true,
+  "use_ik_match_table2": false,
+  "human_scale_table": {
+    "Hips": 0.9,
+    "Spine": 0.8
+  },
+  "ik_match_table1": {
+    "b": ["Spine", 1.0, 2.0, [0.000000003, -0.25, 0.3333333333333333], [1.0, 0.0, 0.0, 0.0]],
+    "a": ["Hips", 0.0, 10.0, [0.1, 0.0, 0.0], [0.5, 0.5, 0.5, 0.5]]
+  },
+  "ik_match_table2": {
+  }
+}
+"#;
+        assert_eq!(c.json(), want);
+        assert_eq!(IkConfig::from_json_str(want, "t.json").unwrap(), c);
+        let mut twice = file;
+        twice.ik_match_table1.0[1].0 = "b".to_owned();
+        let err = IkConfig::from_file_form(twice, "t.json").unwrap_err().to_string();
+        assert!(err.contains("duplicate key `b`"), "{err}");
     }
 
     #[test]

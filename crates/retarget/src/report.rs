@@ -702,7 +702,7 @@ fn foot_heights(
     let geoms: Vec<usize> = (0..model.geoms.len())
         .filter(|&g| {
             let geom = &model.geoms[g];
-            crate::feet::is_descendant(model, geom.body, foot) && geom.kind.is_primitive()
+            model.is_ancestor_or_self(foot, geom.body) && geom.kind.is_primitive()
         })
         .collect();
     // Without geoms, the foot's equivalent inertia box, as the planner's sole.

@@ -399,7 +399,7 @@ impl<'m> Recogniser<'m> {
             }
         }
         let mut r = Recogniser { model, data, children, lowest, base, height: 0.0 };
-        let bodies = r.subtree(base);
+        let bodies = r.model.subtree(base);
         let low = bodies.iter().map(|&b| r.lowest[b]).fold(f64::INFINITY, f64::min);
         let high = bodies.iter().map(|&b| r.data.xpos[b].z).fold(f64::NEG_INFINITY, f64::max);
         r.height = high - low;
@@ -417,42 +417,10 @@ impl<'m> Recogniser<'m> {
         body_name(self.model, b)
     }
 
-    /// `b` and its descendants, parents first.
-    fn subtree(&self, b: usize) -> Vec<usize> {
-        let mut out = vec![b];
-        let mut i = 0;
-        while i < out.len() {
-            out.extend_from_slice(&self.children[out[i]]);
-            i += 1;
-        }
-        out
-    }
-
-    fn ancestors(&self, mut b: usize) -> Vec<usize> {
-        let mut out = Vec::new();
-        while b != 0 {
-            b = self.model.bodies[b].parent;
-            out.push(b);
-        }
-        out
-    }
-
-    fn is_ancestor_or_self(&self, a: usize, mut b: usize) -> bool {
-        loop {
-            if a == b {
-                return true;
-            }
-            if b == 0 {
-                return false;
-            }
-            b = self.model.bodies[b].parent;
-        }
-    }
-
     fn lca(&self, a: usize, b: usize) -> usize {
         std::iter::once(a)
-            .chain(self.ancestors(a))
-            .find(|&x| self.is_ancestor_or_self(x, b))
+            .chain(self.model.ancestors(a))
+            .find(|&x| self.model.is_ancestor_or_self(x, b))
             .unwrap_or(0)
     }
 
@@ -635,9 +603,10 @@ impl<'m> Recogniser<'m> {
 
     /// The pelvis and the two feet (see rule 2).
     fn legs(&self) -> Result<(usize, [usize; 2]), Error> {
-        let bodies = self.subtree(self.base);
+        let bodies = self.model.subtree(self.base);
         let lowest_in = |root: usize| {
-            self.subtree(root)
+            self.model
+                .subtree(root)
                 .into_iter()
                 .min_by(|&a, &b| self.lowest[a].total_cmp(&self.lowest[b]).then(b.cmp(&a)))
                 .unwrap_or(root)
@@ -650,14 +619,14 @@ impl<'m> Recogniser<'m> {
             return Err(self.not_humanoid("the floating base carries no bodies".to_owned()));
         };
         let za = self.lowest[a];
-        for anc in self.ancestors(a) {
+        for anc in self.model.ancestors(a) {
             if !bodies.contains(&anc) {
                 break;
             }
             let branch_a = self.path(anc, a)[0];
             let hang = self.data.xpos[branch_a].z - za;
             for &c in &self.children[anc] {
-                if self.is_ancestor_or_self(c, a) {
+                if self.model.is_ancestor_or_self(c, a) {
                     continue;
                 }
                 let b = lowest_in(c);
@@ -685,9 +654,10 @@ impl<'m> Recogniser<'m> {
     ) -> Result<(usize, [usize; 2]), Error> {
         let leg_roots: Vec<usize> = feet.iter().map(|&f| self.path(pelvis, f)[0]).collect();
         let upper: Vec<usize> = self
+            .model
             .subtree(self.base)
             .into_iter()
-            .filter(|&b| !leg_roots.iter().any(|&r| self.is_ancestor_or_self(r, b)))
+            .filter(|&b| !leg_roots.iter().any(|&r| self.model.is_ancestor_or_self(r, b)))
             .collect();
         let side = |b: &usize| (self.data.xpos[*b] - hips).dot(&across);
         let by = |a: &&usize, b: &&usize| side(a).total_cmp(&side(b));
@@ -777,7 +747,7 @@ impl<'m> Recogniser<'m> {
         if hinge.range.is_some() || hinge.axis.dot(&across).abs() < WHEEL_AXIS_COS {
             return false;
         }
-        let bodies = self.subtree(hinge.body);
+        let bodies = self.model.subtree(hinge.body);
         self.model.geoms.iter().enumerate().any(|(g, geom)| {
             let round = match geom.kind {
                 mjcf::GeomType::Sphere => true,
@@ -808,7 +778,8 @@ impl<'m> Recogniser<'m> {
     /// The body of `root`'s subtree farthest from `top` along the tree (a fingertip when
     /// the arm has fingers): the end of the limb that starts at `root`.
     fn farthest_along(&self, top: usize, root: usize) -> usize {
-        self.subtree(root)
+        self.model
+            .subtree(root)
             .into_iter()
             .max_by(|&a, &b| self.path_length(top, a).total_cmp(&self.path_length(top, b)))
             .unwrap_or(root)
@@ -818,7 +789,7 @@ impl<'m> Recogniser<'m> {
     fn jointed_branches(&self, b: usize) -> usize {
         self.children[b]
             .iter()
-            .filter(|&&c| self.subtree(c).iter().any(|&x| self.model.bodies[x].jnt_num > 0))
+            .filter(|&&c| self.model.subtree(c).iter().any(|&x| self.model.bodies[x].jnt_num > 0))
             .count()
     }
 
@@ -893,9 +864,10 @@ impl<'m> Recogniser<'m> {
     ) -> Option<(usize, String)> {
         let limbs: Vec<usize> = arms.iter().chain(legs).map(|l| l.chain[0]).collect();
         let top = self
+            .model
             .subtree(self.base)
             .into_iter()
-            .filter(|&b| !limbs.iter().any(|&r| self.is_ancestor_or_self(r, b)))
+            .filter(|&b| !limbs.iter().any(|&r| self.model.is_ancestor_or_self(r, b)))
             .filter(|&b| !robot_names::is_extra(&self.name(b)))
             .max_by(|&a, &b| self.data.xpos[a].z.total_cmp(&self.data.xpos[b].z))?;
         if self.data.xpos[top].z < shoulders_z + 0.03 * self.height {
@@ -926,11 +898,12 @@ impl<'m> Recogniser<'m> {
             let ankle = joint_centre(&leg.distal);
             let foot_root = leg.distal.first().map_or(leg.middle.body, |h| h.body);
             let mut reach = Vector3::zeros();
-            for b in self.subtree(foot_root) {
+            for b in self.model.subtree(foot_root) {
                 reach += self.data.xpos[b] - ankle;
             }
             for (g, geom) in self.model.geoms.iter().enumerate() {
-                if self.is_ancestor_or_self(foot_root, geom.body) && geom.kind.is_primitive() {
+                if self.model.is_ancestor_or_self(foot_root, geom.body) && geom.kind.is_primitive()
+                {
                     reach += self.data.geom_xpos[g] - ankle;
                 }
             }
@@ -997,7 +970,7 @@ impl<'m> Recogniser<'m> {
     /// The sole under a foot (rule 7).
     fn sole(&self, roles: &BTreeMap<Role, RobotRole>, leg: &Limb, side: Side) -> Sole {
         let body = roles.get(&Role::of(Part::Foot, side)).map_or(leg.middle.body, |r| r.body);
-        let bodies = self.subtree(body);
+        let bodies = self.model.subtree(body);
         let mut geoms: Vec<(usize, Vector3<f64>)> = self
             .model
             .geoms

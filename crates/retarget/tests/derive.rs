@@ -29,6 +29,54 @@ fn lafan_walk() -> Option<bvh::Bvh> {
     Some(bvh::from_path(&path).unwrap())
 }
 
+/// Every robot derive runs on: the shipped ones, the test robots and the reference ones
+/// (MJCF and URDF).
+fn robots_derive_runs_on() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> =
+        std::fs::read_dir(root().join("robots")).unwrap().map(|e| e.unwrap().path()).collect();
+    dirs.push(root().join("crates/retarget/tests/data/robots"));
+    if let Some(reference) = shared::shared_file("reference/robots") {
+        dirs.extend(std::fs::read_dir(reference).unwrap().map(|e| e.unwrap().path()));
+    }
+    let mut out: Vec<PathBuf> = dirs
+        .into_iter()
+        .filter(|d| d.is_dir())
+        .flat_map(|d| std::fs::read_dir(d).unwrap().map(|f| f.unwrap().path()))
+        .filter(|f| matches!(f.extension().and_then(|e| e.to_str()), Some("xml" | "urdf")))
+        .collect();
+    out.sort();
+    out
+}
+
+/// A derived or bound config reads back from its text ([`IkConfig::json`], what `retarget
+/// robot init` writes) as the same config, on every robot derive runs on, against the
+/// canonical human and the LAFAN1 walk; its table rows are one a line, as in GMR's files.
+#[test]
+fn derived_configs_read_back_from_their_text_unchanged() {
+    let Some(bvh) = lafan_walk() else { return };
+    let walk = derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
+    let mut checked = 0;
+    for path in robots_derive_runs_on() {
+        let model = mjcf::Model::from_path(&path).unwrap();
+        let Ok(roles) = RobotRoles::recognise(&model) else { continue };
+        let canonical = derive::derive(&model, &roles, &HumanBody::canonical(), "c").unwrap();
+        let derived = derive::derive(&model, &roles, &walk, "d").unwrap();
+        let bound = derive::bind(&canonical, &walk, &model, &roles).unwrap();
+        for config in [canonical, derived, bound] {
+            let read = IkConfig::from_json_str(config.json(), &config.source).unwrap();
+            assert_eq!(read, config, "{}", path.display());
+            let rows = config.json().lines().filter(|l| l.contains("\": [\"")).count();
+            let tables = config.ik_match_table1.len() + config.ik_match_table2.len();
+            assert_eq!(rows, tables, "{}", path.display());
+            checked += 1;
+        }
+    }
+    // The shipped robots and the recognised test robots, and without RETARGET_SHARED skipped
+    // (outside CI) the reference ones.
+    let reference = shared::shared_file("reference/robots").is_some();
+    assert!(checked >= if reference { 26 * 3 } else { 8 * 3 }, "{checked}");
+}
+
 /// A role-named config (`retarget robot init` without `--bvh`) bound to a skeleton is the
 /// config derived for that skeleton directly, on every robot with a GMR config.
 #[test]

@@ -7,7 +7,6 @@
 
 use mjcf::Model;
 
-use super::tree::is_descendant;
 use crate::error::Error;
 use crate::robot_roles::RobotRoles;
 
@@ -50,7 +49,7 @@ pub fn detect_feet(model: &Model) -> Result<[usize; 2], Error> {
         // one. (Planting that ankle link planted the shin, its tracked ancestor.)
         (Some(l), Some(r), Ok([rl, rr])) if l != r => {
             let foot = |named: usize, found: usize| {
-                if is_descendant(model, found, named) {
+                if model.is_ancestor_or_self(named, found) {
                     found
                 } else {
                     named

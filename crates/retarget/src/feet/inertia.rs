@@ -8,7 +8,6 @@
 use mjcf::{Data, Model};
 use nalgebra::{Isometry3, Translation3};
 
-use super::tree::is_descendant;
 
 /// Shortest and longest plausible half length (m) of a foot's equivalent inertia box
 /// ([`inertia_sole`]).
@@ -42,7 +41,7 @@ impl InertiaSole {
 /// inertial.
 pub(crate) fn inertia_sole(model: &Model, sole_body: usize) -> Option<InertiaSole> {
     (0..model.bodies.len())
-        .filter(|&b| is_descendant(model, b, sole_body))
+        .filter(|&b| model.is_ancestor_or_self(sole_body, b))
         .filter_map(|b| {
             let inertial = model.bodies[b].inertial?;
             let half = inertial.equivalent_box()?;

@@ -54,7 +54,6 @@ mod options;
 mod soles;
 mod stance;
 mod swing;
-mod tree;
 mod uncross;
 
 use crate::lie::Pose;
@@ -71,7 +70,6 @@ pub(crate) use inertia::inertia_sole;
 pub(crate) use math::wrap;
 pub use options::{Anchor, FootPlanOptions};
 pub use soles::{RobotFoot, SolePoint, CONTACT_PATCH};
-pub(crate) use tree::is_descendant;
 pub use uncross::{Crossing, Uncrossing};
 
 /// What [`plan`] did: the vertical shift and per frame the weight factor of each foot.

@@ -13,7 +13,6 @@ use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
 use super::inertia::inertia_sole;
 use super::math::{quat, smoothstep, wrap};
-use super::tree::is_descendant;
 use crate::constraints::{collision_primitives, support_offset};
 use crate::lie::Pose;
 
@@ -78,7 +77,7 @@ impl RobotFoot {
         let inverse = body_pose.inverse();
         let geoms: Vec<usize> = collision_primitives(model)
             .into_iter()
-            .filter(|&g| is_descendant(model, model.geoms[g].body, sole_body))
+            .filter(|&g| model.is_ancestor_or_self(sole_body, model.geoms[g].body))
             .collect();
         let mut sole: Vec<_> = geoms
             .iter()

@@ -130,7 +130,7 @@ pub fn reweigh(
             task.pos_weight -= share * (task.pos_weight - options.root_position_weight_cap);
         }
         if let Some(arms) = &arms {
-            if !arms.iter().any(|&arm| crate::feet::is_descendant(model, task.body, arm)) {
+            if !arms.iter().any(|&arm| model.is_ancestor_or_self(arm, task.body)) {
                 task.rot_weight *= trunk;
             }
         }

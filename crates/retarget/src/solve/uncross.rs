@@ -11,7 +11,6 @@ use std::ops::Range;
 
 use super::prepare::{Prepared, Solved};
 use super::SolveMode;
-use crate::feet::is_descendant;
 use crate::solver::FrameDiagnostics;
 use crate::Error;
 
@@ -92,11 +91,11 @@ impl<'a> Prepared<'a> {
         // The geom pairs between the two legs: each leg is the subtree of the foot's highest
         // ancestor that the other foot does not hang from (as `feet::leg_length` walks up).
         let top = |foot: usize, other: usize| {
-            if is_descendant(model, other, foot) {
+            if model.is_ancestor_or_self(foot, other) {
                 return None;
             }
             let mut body = foot;
-            while !is_descendant(model, other, model.bodies[body].parent) {
+            while !model.is_ancestor_or_self(model.bodies[body].parent, other) {
                 body = model.bodies[body].parent;
             }
             Some(body)
@@ -108,9 +107,9 @@ impl<'a> Prepared<'a> {
         };
         let leg_of = |g: usize| {
             let body = model.geoms[g].body;
-            if is_descendant(model, body, top_left) {
+            if model.is_ancestor_or_self(top_left, body) {
                 Some(0)
-            } else if is_descendant(model, body, top_right) {
+            } else if model.is_ancestor_or_self(top_right, body) {
                 Some(1)
             } else {
                 None
