@@ -627,12 +627,12 @@ fn load_bvh_gmr<'py>(
     path: PathBuf,
     format: &str,
 ) -> PyResult<(Bound<'py, PyList>, f64)> {
-    let format = retarget::gmr::BvhFormat::from_name(format)
+    let format = retarget::GmrBvhFormat::from_name(format)
         .ok_or_else(|| PyValueError::new_err(format!("Invalid format: {format}")))?;
     let human = py
         .detach(|| {
             let bvh = bvh::from_path(&path)?;
-            retarget::gmr::load_bvh(&bvh, format)
+            retarget::load_bvh_gmr(&bvh, format)
         })
         .map_err(|e: retarget::Error| to_py(e))?;
     let frames = PyList::empty(py);
@@ -648,7 +648,7 @@ fn load_bvh_gmr<'py>(
         }
         frames.append(frame)?;
     }
-    Ok((frames, retarget::gmr::HUMAN_HEIGHT))
+    Ok((frames, retarget::GMR_HUMAN_HEIGHT))
 }
 
 /// A take given as a name (``str``) or an index (``int``).

@@ -25,6 +25,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::motion::RobotMotion;
+use crate::Error;
 
 pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
@@ -69,10 +70,6 @@ impl Format {
         }
     }
 }
-
-/// Errors of the writers, the `.npz` reader and the quality report: the crate's one
-/// [`crate::Error`].
-pub use crate::Error;
 
 /// Writes `motion` to `path` in `format` (by default the one of the extension), atomically.
 ///
