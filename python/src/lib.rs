@@ -284,8 +284,9 @@ impl Retargeter {
     fn last_targets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let out = PyDict::new(py);
         for (name, pose) in self.inner.last_step_targets() {
-            let pos = vec![pose.pos.x, pose.pos.y, pose.pos.z].into_pyarray(py);
-            let quat = pose.quat.to_vec().into_pyarray(py);
+            let (t, q) = (&pose.translation.vector, &pose.rotation);
+            let pos = vec![t.x, t.y, t.z].into_pyarray(py);
+            let quat = vec![q.w, q.i, q.j, q.k].into_pyarray(py);
             out.set_item(name, (pos, quat))?;
         }
         Ok(out)
