@@ -284,8 +284,9 @@ impl Retargeter {
     fn last_targets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let out = PyDict::new(py);
         for (name, pose) in self.inner.last_step_targets() {
-            let pos = vec![pose.pos.x, pose.pos.y, pose.pos.z].into_pyarray(py);
-            let quat = pose.quat.to_vec().into_pyarray(py);
+            let (t, q) = (&pose.translation.vector, &pose.rotation);
+            let pos = vec![t.x, t.y, t.z].into_pyarray(py);
+            let quat = vec![q.w, q.i, q.j, q.k].into_pyarray(py);
             out.set_item(name, (pos, quat))?;
         }
         Ok(out)
@@ -627,12 +628,12 @@ fn load_bvh_gmr<'py>(
     path: PathBuf,
     format: &str,
 ) -> PyResult<(Bound<'py, PyList>, f64)> {
-    let format = retarget::gmr::BvhFormat::from_name(format)
+    let format = retarget::GmrBvhFormat::from_name(format)
         .ok_or_else(|| PyValueError::new_err(format!("Invalid format: {format}")))?;
     let human = py
         .detach(|| {
             let bvh = bvh::from_path(&path)?;
-            retarget::gmr::load_bvh(&bvh, format)
+            retarget::load_bvh_gmr(&bvh, format)
         })
         .map_err(|e: retarget::Error| to_py(e))?;
     let frames = PyList::empty(py);
@@ -648,7 +649,7 @@ fn load_bvh_gmr<'py>(
         }
         frames.append(frame)?;
     }
-    Ok((frames, retarget::gmr::HUMAN_HEIGHT))
+    Ok((frames, retarget::GMR_HUMAN_HEIGHT))
 }
 
 /// A take given as a name (``str``) or an index (``int``).

@@ -248,7 +248,7 @@ impl Job {
         let model = self.retargeter.model();
         match self.fps {
             Some(fps) => {
-                let resampled = retarget::resample::resample(&motion, model, fps)?;
+                let resampled = retarget::resample(&motion, model, fps)?;
                 write_motion(dst, &resampled, model, Some(self.format))?;
             }
             None => write_motion(dst, &motion, model, Some(self.format))?,

@@ -109,7 +109,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     }
     let mut text = rep.to_string();
     if let Ok(roles) = retarget::RobotRoles::recognise(&model) {
-        for blocked in retarget::follow::blocked_limbs(&model, &roles, &motion) {
+        for blocked in retarget::blocked_limbs(&model, &roles, &motion) {
             text.push_str(&format!("cannot follow: {blocked}\n"));
         }
     }

@@ -168,7 +168,7 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     let model = retargeter.model();
     match args.fps {
         Some(fps) => {
-            let resampled = retarget::resample::resample(&motion, model, fps)?;
+            let resampled = retarget::resample(&motion, model, fps)?;
             write_motion(&output, &resampled, model, format)?;
             println!(
                 "resampled {} frames at {} fps to {} frames at {fps} fps",
@@ -188,11 +188,11 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
 /// Stretches of `cannot follow` the main command prints.
 const SHOWN_BLOCKED: usize = 5;
 
-/// The stretches in which a limb cannot follow the human ([`retarget::follow`]), one line
+/// The stretches in which a limb cannot follow the human ([`retarget::blocked_limbs`]), one line
 /// each, the longest first (nothing for a robot the recogniser does not read).
 pub fn print_blocked(model: &mjcf::Model, motion: &RobotMotion) {
     let Ok(roles) = retarget::RobotRoles::recognise(model) else { return };
-    let mut blocked = retarget::follow::blocked_limbs(model, &roles, motion);
+    let mut blocked = retarget::blocked_limbs(model, &roles, motion);
     // The longest first, five at most (`retarget report` lists them all).
     blocked.sort_by_key(|b| std::cmp::Reverse(b.last - b.first));
     for b in blocked.iter().take(SHOWN_BLOCKED) {

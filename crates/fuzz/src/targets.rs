@@ -361,7 +361,7 @@ impl Target for C3dTarget {
         let file = c3d::C3d::from_reader(Cursor::new(input)).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
         let _ = file.write(&mut out, c3d::Format::INTEL_FLOAT);
-        let (labels, frames) = retarget::marker_config::labelled_points(&file);
+        let (labels, frames) = retarget::internals::labelled_points(&file);
         let bodies: Vec<fk::markers::MarkerBody> = labels
             .chunks(3)
             .enumerate()
@@ -869,17 +869,19 @@ impl Target for ConfigTarget {
         let model = g1();
         config.validate(model, &human).map_err(|e| e.to_string())?;
         let map =
-            retarget::targets::TargetMap::new(&config, &human, 1.7).map_err(|e| e.to_string())?;
+            retarget::internals::TargetMap::new(&config, &human, 1.7).map_err(|e| e.to_string())?;
         let positions: Vec<nalgebra::Vector3<f64>> =
             (0..human.len()).map(|k| nalgebra::Vector3::new(0.0, 0.1 * k as f64, 1.0)).collect();
         let orientations = vec![nalgebra::UnitQuaternion::identity(); human.len()];
-        let mut out =
-            vec![
-                retarget::lie::Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: nalgebra::Vector3::zeros() };
-                map.bodies.len()
-            ];
+        let mut out = vec![
+            retarget::internals::Pose {
+                quat: [1.0, 0.0, 0.0, 0.0],
+                pos: nalgebra::Vector3::zeros()
+            };
+            map.bodies.len()
+        ];
         map.compute(&positions, &orientations, &mut out);
-        let _ = retarget::solve::task_specs(&config, model, &map);
+        let _ = retarget::internals::task_specs(&config, model, &map);
         Ok(())
     }
 }

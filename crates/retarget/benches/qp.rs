@@ -12,7 +12,7 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
-use retarget::qp::{DenseQp, QpStatus};
+use retarget::internals::{DenseQp, QpStatus};
 
 const BODIES: [&str; 14] = [
     "pelvis",

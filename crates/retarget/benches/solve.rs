@@ -5,10 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use retarget::lie::Pose;
-use retarget::solve::task_specs;
-use retarget::targets::TargetMap;
-use retarget::{IkConfig, Solver, SolverOptions};
+use retarget::internals::task_specs;
+use retarget::internals::Pose;
+use retarget::internals::Solver;
+use retarget::internals::TargetMap;
+use retarget::{IkConfig, SolverOptions};
 
 fn shared() -> Option<PathBuf> {
     std::env::var_os("RETARGET_SHARED").map(PathBuf::from)

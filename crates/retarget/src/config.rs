@@ -37,7 +37,7 @@ pub struct MatchEntry {
     /// Position offset in the (rotated) human body frame, metres.
     pub pos_offset: Vector3<f64>,
     /// Rotation offset, applied on the right of the human body orientation. Stored as written
-    /// (GMR does not normalise it beyond what scipy does; see [`crate::targets`]).
+    /// (GMR does not normalise it beyond what scipy does; see the crate's `targets`).
     pub rot_offset: UnitQuaternion<f64>,
 }
 

@@ -205,12 +205,6 @@ impl SelfCollision {
         }
     }
 
-    /// The pairs kept apart.
-    #[must_use]
-    pub fn pairs(&self) -> &[[usize; 2]] {
-        &self.pairs
-    }
-
     /// The row of a pair at the points `point1` on geom 1 and `point2` on geom 2 with the
     /// normal `n`: `nᵀ (J₂ − J₁)` over both bodies' dof chains (zero elsewhere).
     fn fill_row(

@@ -26,7 +26,7 @@ use nalgebra::Vector3;
 
 use crate::motion::FootContacts;
 
-/// Tunables of [`detect`]; lengths in metres, speeds in m/s, in the source's (human) scale.
+/// Tunables of the contact detection (`detect`); lengths in metres, speeds in m/s, in the source's (human) scale.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactOptions {
     pub height_on: f64,

@@ -75,7 +75,7 @@ pub enum Error {
     #[error(transparent)]
     Mjcf(#[from] mjcf::Error),
     /// A robot model in which no two-armed biped standing at `qpos0` is found
-    /// ([`crate::robot_roles`]).
+    /// ([`crate::RobotRoles`]).
     #[error("robot `{model}` is not a two-armed biped: {reason}")]
     NotHumanoid { model: String, reason: String },
     /// Non-finite target or solver state at a frame.

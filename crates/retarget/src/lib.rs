@@ -59,51 +59,111 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Underneath: [`config`] (GMR-schema IK configs), [`derive`](mod@derive) and [`robot_roles`] (configs
-//! derived for any skeleton and robot), [`targets`], [`solver`] and [`solve`] (the solve, stage by stage:
-//! [`SolveMode::Gmr`] is GMR's exactly, the default adds planted feet and hard constraints),
-//! [`motion`], [`writers`] and [`report`]. Every fallible call returns the one [`Error`].
+//! # The API
+//!
+//! - **The way in**: [`Retargeter`], fed whole clips or one [`HumanFrame`] at a time;
+//!   [`Retargeter::retarget_files`] gives one [`FileResult`] per file.
+//! - **Options** (each with a `Default`): [`RetargetOptions`] holds the [`SolveMode`] —
+//!   [`SolveMode::Gmr`] is GMR's solve exactly, [`SolveMode::Plausible`] (the default) adds
+//!   planted feet and hard constraints, tuned by [`PlausibleOptions`]: [`Planting`],
+//!   [`SpeedLimits`], [`SelfCollisionMode`], [`ContactOptions`], [`FootPlanOptions`] (with its
+//!   [`Anchor`]), [`TrajectoryOptions`] (with its [`Objective`] and [`DynamicsOptions`]). Beside
+//!   the mode: [`SolverOptions`] (with its [`Arithmetic`]) and [`ChunkOptions`].
+//! - **Inputs** besides the human motion: [`IkConfig`] (GMR's schema, of [`MatchEntry`]s),
+//!   [`MarkerConfig`] (C3D markers: [`MarkerHeight`], [`MarkerMotion`]), [`FbxClip`], and
+//!   the robot's recognised [`RobotRoles`] ([`RobotRole`], [`Sole`]).
+//! - **Outputs**: [`RobotMotion`] (with its [`FootContacts`] and [`TrackedTargets`]),
+//!   [`ClipDiagnostics`] of [`FrameDiagnostics`], [`resample`] to another frame rate,
+//!   [`blocked_limbs`] ([`BlockedLimb`], [`PinnedJoint`]): where a limb could not follow.
+//! - **GMR's BVH loader**, for code written against GMR: [`load_bvh_gmr`], [`GmrBvhFormat`],
+//!   [`GMR_HUMAN_HEIGHT`].
+//! - **Modules**: [`writers`] (npz, csv, pkl, json; reading our npz back), [`report`] (the
+//!   quality report), [`derive`](mod@derive) (IK configs derived for any skeleton and robot)
+//!   and [`shipped`] (the robots shipped with the crate).
+//!
+//! Every fallible call returns the one [`Error`].
 
 // Library code never panics on input (issue 15): the compiler checks it. Tests may (clippy.toml).
 // Numeric modules allow indexing with the reason in their header.
+// Every type a public signature mentions has a public name (the facade or `internals`).
+#![deny(unnameable_types)]
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
-pub(crate) mod centroidal;
-pub mod config;
-pub mod constraints;
-pub mod contact;
+// The crate's modules are its own; what users call is the facade below, the four public
+// modules and nothing else (each item has one path). Benches, fuzz targets and integration
+// tests reach internals through `internals`.
+mod centroidal;
+mod config;
+mod constraints;
+mod contact;
 pub mod derive;
 mod error;
-pub mod fbx_clip;
-pub mod feet;
-pub mod follow;
-pub mod gmr;
-pub mod joint_speed;
-pub mod lie;
-pub mod marker_config;
-pub mod motion;
-pub mod qp;
+mod fbx_clip;
+mod feet;
+mod follow;
+mod gmr;
+mod joint_speed;
+mod lie;
+mod marker_config;
+mod motion;
+mod qp;
 pub mod report;
-pub mod resample;
-pub mod retargeter;
-pub mod robot_names;
-pub mod robot_roles;
+mod resample;
+mod retargeter;
+mod robot_names;
+mod robot_roles;
 pub mod shipped;
-pub mod smpl;
-pub mod solve;
-pub mod solver;
-pub mod targets;
+mod smpl;
+mod solve;
+mod solver;
+mod targets;
 pub mod writers;
 
-pub use config::{IkConfig, MatchEntry};
-pub use error::Error;
-pub use fbx_clip::FbxClip;
-pub use marker_config::MarkerConfig;
-pub use motion::{FootContacts, RobotMotion, TrackedTargets};
+// The way in.
 pub use retargeter::{FileResult, HumanFrame, Retargeter};
-pub use robot_roles::{RobotRole, RobotRoles, Sole};
+
+// The options: what a user sets.
+pub use contact::ContactOptions;
+pub use feet::{Anchor, FootPlanOptions};
+pub use solve::trajectory::Objective;
 pub use solve::{
-    retarget_bvh, retarget_motion, retarget_motion_chunked, ChunkOptions, ClipDiagnostics,
-    Planting, PlausibleOptions, RetargetOptions, SolveMode, SpeedLimits,
+    ChunkOptions, DynamicsOptions, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode,
+    SolveMode, SpeedLimits, TrajectoryOptions,
 };
-pub use solver::{Arithmetic, FrameDiagnostics, Solver, SolverOptions, TaskSpec};
+pub use solver::{Arithmetic, SolverOptions};
+
+// The inputs besides the human motion: IK and marker configs, FBX clips, robot roles.
+pub use config::{IkConfig, MatchEntry};
+pub use fbx_clip::FbxClip;
+pub use marker_config::{MarkerConfig, MarkerHeight, MarkerMotion};
+pub use robot_roles::{RobotRole, RobotRoles, Sole};
+
+// The outputs.
+pub use follow::{blocked_limbs, Blocked as BlockedLimb, PinnedJoint};
+pub use motion::{FootContacts, RobotMotion, TrackedTargets};
+pub use resample::resample;
+pub use solve::ClipDiagnostics;
+pub use solver::FrameDiagnostics;
+
+// GMR's BVH loader, for code written against GMR.
+pub use gmr::{
+    load_bvh as load_bvh_gmr, BvhFormat as GmrBvhFormat, HUMAN_HEIGHT as GMR_HUMAN_HEIGHT,
+};
+
+pub use error::Error;
+
+/// Not API: the crate's internals, for benches, fuzz targets and integration tests. They may
+/// change at any time.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::constraints::{Constraint, StepContext};
+    pub use crate::feet::detect_feet;
+    pub use crate::joint_speed::JointSpeedLimits;
+    pub use crate::lie::{mat_to_quat, Pose};
+    pub use crate::marker_config::labelled_points;
+    pub use crate::qp::{DenseQp, QpStatus};
+    pub use crate::smpl::{frames_from, GMR_FIRST_FRAME};
+    pub use crate::solve::{retarget_bvh, retarget_motion, retarget_motion_chunked, task_specs};
+    pub use crate::solver::{PointTask, Solver, TaskSpec};
+    pub use crate::targets::{ScaledBody, TargetMap};
+}

@@ -141,14 +141,8 @@ pub fn rminus(a: &Pose, b: &Pose) -> Vector6<f64> {
     se3_log(&inverse_multiply(b, a))
 }
 
-/// Left Jacobian inverse of SO(3) (eq. 146), mink's expansion order.
-#[must_use]
-pub fn so3_ljacinv(omega: &Vector3<f64>) -> Matrix3<f64> {
-    let theta = omega.norm();
-    so3_ljacinv_with(omega, theta, theta.sin_cos())
-}
-
-/// [`so3_ljacinv`] given `θ = |ω|` and `(sin θ, cos θ)`.
+/// Left Jacobian inverse of SO(3) (eq. 146), mink's expansion order, given `θ = |ω|` and
+/// `(sin θ, cos θ)`.
 fn so3_ljacinv_with(omega: &Vector3<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
     let t2 = theta * theta;
     let beta = if theta < EPS {
@@ -240,6 +234,7 @@ pub fn se3_jlog_at(neg: &Vector6<f64>) -> Matrix6<f64> {
 }
 
 /// SE(3) exponential (for tests): `exp([v; ω])`.
+#[cfg(test)]
 #[must_use]
 pub fn se3_exp(t: &Vector6<f64>) -> Pose {
     let w = Vector3::new(t[3], t[4], t[5]);

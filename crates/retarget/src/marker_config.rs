@@ -200,7 +200,7 @@ fn labels(v: &Value, key: &str, source: &str) -> Result<Vec<String>, Error> {
 /// Per frame and point, a point's position in file units (`None` where it is invalid).
 pub type PointFrames = Vec<Vec<Option<[f64; 3]>>>;
 
-/// A C3D file's point labels (trimmed) and their positions ([`PointFrames`]).
+/// A C3D file's point labels (trimmed) and their positions (`PointFrames`: per frame, per label).
 #[must_use]
 pub fn labelled_points(file: &c3d::C3d) -> (Vec<String>, PointFrames) {
     let labels: Vec<String> = file.point_labels().iter().map(|l| l.trim().to_owned()).collect();

@@ -53,7 +53,7 @@
 //!   which the contact point (above, followed as a point of the foot) moves faster than
 //!   [`ReportOptions::skate_speed`] ([`FootReport::floor_skating_share`]).
 //! - **Skating** (needs the source's foot contacts): a foot's speed at frame t is
-//!   `|xy[t] − xy[t−1]| · fps` of its toe point ([`crate::feet::RobotFoot::toe_point`]: the
+//!   `|xy[t] − xy[t−1]| · fps` of its toe point (`RobotFoot::toe_point`: the
 //!   middle of the sole's front bottom edge; the body origin when the foot has no collision
 //!   primitive), 0 at frame 0 (holosoma: backward
 //!   differences with a leading 0). A foot **skates** in a frame when the source foot is in
@@ -167,7 +167,8 @@ pub use rates::{AccelStats, Jitter, RootAcceleration, GRAVITY};
 
 use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
-use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses, Error};
+use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses};
+use crate::Error;
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]

@@ -27,7 +27,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use bvh::Bvh;
 use fk::HumanMotion;
 use mjcf::Model;
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Quaternion, UnitQuaternion, Vector3};
 
 use crate::config::IkConfig;
 use crate::derive::Chosen;
@@ -486,14 +486,22 @@ impl Retargeter {
         stream.step(frame)
     }
 
-    /// The targets of the last streamed frame: per scaled human body its name, world position
-    /// and orientation after scaling and offsets (GMR's `scaled_human_data`).
+    /// The targets of the last streamed frame: per scaled human body its name and world pose
+    /// (`world_from_target`) after scaling and offsets (GMR's `scaled_human_data`).
     #[must_use]
-    pub fn last_step_targets(&self) -> Vec<(String, Pose)> {
+    pub fn last_step_targets(&self) -> Vec<(String, Isometry3<f64>)> {
         let guard = self.stream.lock().unwrap_or_else(PoisonError::into_inner);
+        let world_from_target = |p: &Pose| {
+            let [w, i, j, k] = p.quat;
+            Isometry3::from_parts(
+                p.pos.into(),
+                UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
+            )
+        };
         match guard.as_ref() {
             Some(s) if s.frames > 0 => {
-                s.map.bodies.iter().map(|b| b.name.clone()).zip(s.targets.iter().copied()).collect()
+                let names = s.map.bodies.iter().map(|b| b.name.clone());
+                names.zip(s.targets.iter().map(world_from_target)).collect()
             }
             _ => Vec::new(),
         }

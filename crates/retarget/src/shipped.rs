@@ -22,7 +22,7 @@ pub struct ShippedRobot {
     pub key: &'static str,
     /// `robots/<key>/<key>.xml`.
     pub mjcf: &'static str,
-    /// `robots/<key>/joint_speed_limits.json` ([`crate::joint_speed`]).
+    /// `robots/<key>/joint_speed_limits.json`.
     pub joint_speed_limits: &'static str,
     /// `configs/bvh_lafan1_to_<key>.json`: GMR's tuned IK config for LAFAN1-named skeletons.
     pub config: &'static str,
@@ -55,12 +55,12 @@ pub const ROBOTS: &[ShippedRobot] = &[
 
 /// GMR's SMPL-X configs of the shipped robots that have one (`configs/smplx_to_<key>.json`,
 /// GMR's `smplx_to_*.json` reformatted), for SMPL-X and SMPL+H motions, by robot key.
-pub const SMPLX_CONFIGS: &[(&str, &str)] = &[
+pub(crate) const SMPLX_CONFIGS: &[(&str, &str)] = &[
     ("booster_t1_29dof", include_str!("../../../configs/smplx_to_booster_t1_29dof.json")),
     ("unitree_g1", include_str!("../../../configs/smplx_to_unitree_g1.json")),
 ];
 
-/// The SMPL-X config of the shipped robot `key` ([`SMPLX_CONFIGS`]), named by its path in
+/// The SMPL-X config of the shipped robot `key` (`SMPLX_CONFIGS`), named by its path in
 /// the repository; `None` when it has none.
 #[must_use]
 pub fn smplx_config(key: &str) -> Option<Result<IkConfig, Error>> {
@@ -113,11 +113,11 @@ pub fn tuned_config(key: &str) -> Option<Result<IkConfig, Error>> {
 /// A shipped robot by key, else the model file at that path (`.xml` MJCF or `.urdf` URDF, by
 /// [`Model::from_path`]). An unknown name that is not a file is [`Error::UnknownRobot`].
 /// Joint speed limits come from the robot's `joint_speed_limits.json`
-/// ([`crate::joint_speed`]): the shipped one, or one beside a model file when present (a
+/// (`joint_speed_limits.json`): the shipped one, or one beside a model file when present (a
 /// URDF's own `velocity` limits are kept unless the file lists the joint).
 ///
 /// A model without a free joint gets a floating base
-/// ([`crate::robot_roles::add_floating_base`]); [`load_robot_noted`] says so.
+/// (`add_floating_base`); [`load_robot_noted`] says so.
 pub fn load_robot(name_or_path: &str) -> Result<Model, Error> {
     load_robot_noted(name_or_path).map(|(model, _)| model)
 }
@@ -148,7 +148,7 @@ pub fn load_robot_noted(name_or_path: &str) -> Result<(Model, Vec<String>), Erro
 /// [`Error::UnknownRobot`] for `name`: the shipped robots, and the nearest one by name when
 /// one is close (Jaro-Winkler similarity ≥ 0.7, as clap suggests subcommands).
 #[must_use]
-pub fn unknown_robot(name: &str) -> Error {
+pub(crate) fn unknown_robot(name: &str) -> Error {
     let nearest = keys()
         .map(|k| (strsim::jaro_winkler(name, k), k))
         .filter(|(score, _)| *score >= 0.7)
@@ -164,7 +164,7 @@ pub fn unknown_robot(name: &str) -> Error {
 /// Whether a robot argument names a model file rather than a shipped robot: an existing file,
 /// or a name with an extension or a path separator.
 #[must_use]
-pub fn looks_like_path(name_or_path: &str) -> bool {
+pub(crate) fn looks_like_path(name_or_path: &str) -> bool {
     let path = Path::new(name_or_path);
     path.is_file() || path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR)
 }

@@ -83,7 +83,7 @@ pub fn frames_from(human: &HumanMotion, from: usize) -> HumanMotion {
 }
 
 impl Retargeter {
-    /// The config an SMPL clip is retargeted with, and why ([`choose`]).
+    /// The config an SMPL clip is retargeted with, and why.
     pub fn choose_smpl_config(&self, clip: &smpl::Clip) -> Result<Chosen, Error> {
         choose(self.model(), self.label(), clip, self.given_config().cloned(), self.smplx_config())
     }

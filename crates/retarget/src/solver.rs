@@ -118,7 +118,7 @@ pub struct FrameDiagnostics {
     pub pos_error: Vec<f64>,
     /// Per tracked body: angle to its target orientation (rad).
     pub rot_error: Vec<f64>,
-    /// Joints (indices into `Model::joints`) within [`AT_LIMIT`] of a range end.
+    /// Joints (indices into `Model::joints`) within `AT_LIMIT` of a range end.
     pub at_limit: Vec<usize>,
     /// QP solves that did not reach the exact optimum (should stay 0).
     pub qp_failures: usize,

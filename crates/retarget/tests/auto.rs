@@ -74,7 +74,7 @@ fn run_with(
     let gmr = options.mode == retarget::SolveMode::Gmr;
     let chosen = derive::choose(model, robot, bvh, &fk_options, None, tuned, gmr)
         .unwrap_or_else(|e| panic!("{robot}: {e}"));
-    let (motion, _) = retarget::retarget_bvh(bvh, model, &chosen.config, options)
+    let (motion, _) = retarget::internals::retarget_bvh(bvh, model, &chosen.config, options)
         .unwrap_or_else(|e| panic!("{robot}: {e}"));
     let (human, report) = fk::human_motion(bvh, &fk_options).unwrap();
     let humanoid = report.humanoid.unwrap();
@@ -481,7 +481,7 @@ fn small(name: &str) -> mjcf::Model {
 }
 
 /// The MocapBank take sits on a chair: the G1's left hip pitch stops at −90°, so its left leg
-/// cannot follow the human there, and the tool says so (`retarget::follow`); the LAFAN1 walk's
+/// cannot follow the human there, and the tool says so (`retarget::blocked_limbs`); the LAFAN1 walk's
 /// start is walked without such a stretch.
 #[test]
 fn a_limb_held_at_its_joint_limits_is_said_not_to_follow() {
@@ -492,17 +492,19 @@ fn a_limb_held_at_its_joint_limits_is_said_not_to_follow() {
         let chosen =
             derive::choose(&model, "unitree_g1", bvh, &fk::FkOptions::default(), None, None, false)
                 .unwrap();
-        retarget::retarget_bvh(bvh, &model, &chosen.config, &RetargetOptions::default()).unwrap().0
+        retarget::internals::retarget_bvh(bvh, &model, &chosen.config, &RetargetOptions::default())
+            .unwrap()
+            .0
     };
     let motion = solve(&bvh::from_path(&path).unwrap());
-    let blocked = retarget::follow::blocked_limbs(&model, &roles, &motion);
+    let blocked = retarget::blocked_limbs(&model, &roles, &motion);
     let leg = blocked.iter().find(|b| b.limb == "left leg").expect("the left leg is blocked");
     assert!(leg.last - leg.first > 150, "{leg}");
     assert!(leg.joints.iter().any(|j| j.name == "left_hip_pitch_joint" && j.lower), "{leg}");
     assert!(leg.to_string().contains("cannot follow the human"), "{leg}");
     let Some(walk) = lafan_walk() else { return };
     let motion = solve(&walk);
-    assert_eq!(retarget::follow::blocked_limbs(&model, &roles, &motion), []);
+    assert_eq!(retarget::blocked_limbs(&model, &roles, &motion), []);
 }
 
 /// Issue 31: every shipped robot retargets the synthetic SMPL-X walk and SMPL+H walk of
@@ -519,9 +521,9 @@ fn every_shipped_robot_walks_the_smpl_walks_in_both_solves() {
         let motion = motion.slice(0..frames);
         let body = models.for_motion(&motion, None).unwrap();
         let clip = smpl::clip(&body, &motion).unwrap();
-        let gmr_human = retarget::smpl::frames_from(
+        let gmr_human = retarget::internals::frames_from(
             &smpl::gmr::offline_fast(&body, &motion, smpl::conventions::GMR_FPS).unwrap(),
-            retarget::smpl::GMR_FIRST_FRAME,
+            retarget::internals::GMR_FIRST_FRAME,
         );
         for key in retarget::shipped::keys() {
             let model = shipped_model(key);

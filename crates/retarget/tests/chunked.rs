@@ -3,8 +3,8 @@
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
-use retarget::{retarget_motion, IkConfig, RetargetOptions};
-use retarget::{retarget_motion_chunked, ChunkOptions};
+use retarget::internals::{retarget_motion, retarget_motion_chunked};
+use retarget::{ChunkOptions, IkConfig, RetargetOptions};
 
 /// Largest per-joint change between consecutive frames (hinges only), at each frame.
 fn jumps(qpos: &[f64], nq: usize) -> Vec<f64> {

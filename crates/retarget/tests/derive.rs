@@ -297,9 +297,13 @@ fn the_derived_config_is_reachable_on_the_jumps() {
         let (model, _) = shipped(key);
         let roles = RobotRoles::recognise(&model).unwrap();
         let config = derive::derive(&model, &roles, &human, key).unwrap();
-        let (_, diag) =
-            retarget::retarget_bvh(&bvh, &model, &config, &retarget::RetargetOptions::gmr())
-                .unwrap();
+        let (_, diag) = retarget::internals::retarget_bvh(
+            &bvh,
+            &model,
+            &config,
+            &retarget::RetargetOptions::gmr(),
+        )
+        .unwrap();
         let stats = diag.position_error_stats();
         let mean_of = |part: fk::Part| {
             let bodies: Vec<f64> = [fk::Side::Left, fk::Side::Right]
@@ -340,7 +344,8 @@ fn the_scaled_feet_stand_as_wide_as_the_robots() {
         model.kinematics(&model.qpos0, &mut data);
         let stand = (data.xpos[feet[0]] - data.xpos[feet[1]]).y;
         let (motion, _) =
-            retarget::retarget_bvh(&bvh, &model, &config, &RetargetOptions::gmr()).unwrap();
+            retarget::internals::retarget_bvh(&bvh, &model, &config, &RetargetOptions::gmr())
+                .unwrap();
         let targets = motion.targets.as_ref().unwrap();
         let k = feet
             .map(|b| targets.body_names.iter().position(|n| *n == model.bodies[b].name).unwrap());

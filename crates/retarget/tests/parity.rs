@@ -96,7 +96,8 @@ fn lafan1_walk_on_g1_matches_gmr() {
     assert_same_numbers(&config, &gmr_config);
 
     let options = RetargetOptions { human_height: Some(1.75), ..RetargetOptions::gmr() };
-    let (motion, diag) = retarget::retarget_bvh(&bvh, &model, &config, &options).unwrap();
+    let (motion, diag) =
+        retarget::internals::retarget_bvh(&bvh, &model, &config, &options).unwrap();
 
     let (qshape, gmr_q) = f64s(&npz, "qpos");
     assert_eq!(qshape, &[motion.num_frames(), motion.nq]);

@@ -6,9 +6,10 @@
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
-use retarget::joint_speed::JointSpeedLimits;
+use retarget::internals::retarget_motion;
+use retarget::internals::JointSpeedLimits;
 use retarget::report::{report, QualityReport, ReportOptions};
-use retarget::{retarget_motion, IkConfig, RetargetOptions};
+use retarget::{IkConfig, RetargetOptions};
 
 fn g1() -> mjcf::Model {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -155,7 +156,9 @@ fn only_targets_that_disagree_with_the_legs_are_reweighed() {
     let roles = retarget::RobotRoles::recognise(&model).unwrap();
     let derived = retarget::derive::derive(&model, &roles, &human, "derived").unwrap();
     let diag = |config: &IkConfig| {
-        retarget::retarget_bvh(&bvh, &model, config, &RetargetOptions::default()).unwrap().1
+        retarget::internals::retarget_bvh(&bvh, &model, config, &RetargetOptions::default())
+            .unwrap()
+            .1
     };
     let (t, d) = (diag(&tuned), diag(&derived));
     eprintln!(
@@ -165,7 +168,8 @@ fn only_targets_that_disagree_with_the_legs_are_reweighed() {
     assert!(t.pelvis_offset.unwrap() > 0.01 && t.reweigh_share > 0.5, "{t:?}");
     assert!(d.pelvis_offset.unwrap() < 0.007 && d.reweigh_share < 0.2, "{d:?}");
     // GMR's solve is never reweighed.
-    let gmr = retarget::retarget_bvh(&bvh, &model, &tuned, &RetargetOptions::gmr()).unwrap().1;
+    let gmr =
+        retarget::internals::retarget_bvh(&bvh, &model, &tuned, &RetargetOptions::gmr()).unwrap().1;
     assert_eq!((gmr.pelvis_offset, gmr.reweigh_share), (None, 0.0));
 }
 
@@ -217,7 +221,7 @@ fn shipped_file(
 
 /// ToddlerBot's legs (0.28 m): the same centimetres of foot motion are large angles. The
 /// trajectory solve's joint smoothness is set per joint by its tracking stiffness
-/// ([`retarget::solve::trajectory::TrajectoryOptions::joint_cutoff_hz`]); its swing feet stay
+/// ([`retarget::TrajectoryOptions::joint_cutoff_hz`]); its swing feet stay
 /// clear of the floor. Its walk is the one shipped take more jittery than GMR's solve (10.0
 /// against 7.6 rad/s², mostly the ankles within two frames of a contact switch; the
 /// per-frame solve it replaced, with 8 smoothing passes, 7.2): bounded here, not met.

@@ -4,7 +4,7 @@
 mod shared;
 
 use nalgebra::Vector3;
-use retarget::feet::detect_feet;
+use retarget::internals::detect_feet;
 use retarget::report::{report, ReportOptions};
 use retarget::{FootContacts, RobotMotion, TrackedTargets};
 

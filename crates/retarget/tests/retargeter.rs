@@ -128,8 +128,13 @@ fn the_bvh_path_is_the_clis_choice_and_pipeline() {
     assert_eq!(chosen.choice, retarget::derive::Choice::Derived, "CMU names: derived");
     let (motion, diag) = retargeter.retarget_bvh_file(&path).unwrap();
     let model = retarget::shipped::load_robot("unitree_g1").unwrap();
-    let (expected, _) =
-        retarget::retarget_bvh(&bvh, &model, &chosen.config, &RetargetOptions::default()).unwrap();
+    let (expected, _) = retarget::internals::retarget_bvh(
+        &bvh,
+        &model,
+        &chosen.config,
+        &RetargetOptions::default(),
+    )
+    .unwrap();
     assert_eq!(motion.qpos, expected.qpos);
     assert!(diag.human_inferred.ends_with(&chosen.summary), "{}", diag.human_inferred);
 }

@@ -146,7 +146,7 @@ fn gmr_smplx_path_matches_gmr_on_g1_and_t1() {
         // The resampling grid depends on the clip's length: resample it whole, then keep the
         // frames retargeted (from frame 1 on, as GMR's script).
         let resampled = smpl::gmr::offline_fast(&body, &motion, 30.0).unwrap();
-        let human = prefix(&retarget::smpl::frames_from(&resampled, 1), rows);
+        let human = prefix(&retarget::internals::frames_from(&resampled, 1), rows);
         let height = smpl::conventions::gmr_height(&motion.betas);
         let (ours, diag) = retargeter.retarget_with(&human, &config, height).unwrap();
         if run.motion == "walk" && run.robot == "unitree_g1" {

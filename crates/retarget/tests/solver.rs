@@ -11,8 +11,9 @@ use mjcf::{Data, JointType, Model};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use retarget::lie::{mat_to_quat, Pose};
-use retarget::{IkConfig, Solver, SolverOptions, TaskSpec};
+use retarget::internals::{mat_to_quat, Pose};
+use retarget::internals::{Solver, TaskSpec};
+use retarget::{IkConfig, SolverOptions};
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

@@ -8,8 +8,8 @@ use std::process::Command;
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use retarget::writers::{read_motion_npz, read_npz_robot, write_motion, Error, Format};
-use retarget::{RobotMotion, TrackedTargets};
+use retarget::writers::{read_motion_npz, read_npz_robot, write_motion, Format};
+use retarget::{Error, RobotMotion, TrackedTargets};
 use serde_json::Value;
 
 const FPS: f64 = 30.0;

@@ -120,7 +120,7 @@ fn sole_fit(
 /// stay fewer than with GMR's configs (at most 1.0 %); the report's sliding share moves by
 /// −1.4 to +0.6 points; 6 mm and 1 cm take penetration down further (G1 walk 4.4, 3.0 %)
 /// and raise the sliding share of every walk (16.9 → 17.6 → 18.4 %). The default solve
-/// moves every target onto its floor ([`crate::feet`]): there the errors move by at most
+/// moves every target onto its floor (`feet`): there the errors move by at most
 /// 1 mm and the sliding share by at most 0.3 points.
 pub const SOLE_CLEARANCE: f64 = 0.003;
 

@@ -8,7 +8,6 @@
 use mjcf::{Data, Model};
 use nalgebra::{Isometry3, Translation3};
 
-
 /// Shortest and longest plausible half length (m) of a foot's equivalent inertia box
 /// ([`inertia_sole`]).
 const INERTIA_SOLE_HALF_LENGTH: [f64; 2] = [0.03, 0.2];

@@ -69,7 +69,7 @@ pub use detect::detect_feet;
 pub(crate) use inertia::inertia_sole;
 pub(crate) use math::wrap;
 pub use options::{Anchor, FootPlanOptions};
-pub use soles::{RobotFoot, SolePoint, CONTACT_PATCH};
+pub use soles::{RobotFoot, SolePoint};
 pub use uncross::{Crossing, Uncrossing};
 
 /// What [`plan`] did: the vertical shift and per frame the weight factor of each foot.
@@ -91,6 +91,7 @@ pub struct FootPlan {
 }
 
 /// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
+#[cfg(test)]
 pub fn plan(
     feet: &[Option<RobotFoot>; 2],
     contacts: &FootContacts,

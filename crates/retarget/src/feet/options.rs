@@ -9,7 +9,7 @@ pub enum Anchor {
     PhaseMean,
 }
 
-/// Tunables of [`plan`](super::plan).
+/// Tunables of the foot plan (`plan`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FootPlanOptions {
     /// Where a planted foot stays during its stance phase.
@@ -32,7 +32,7 @@ pub struct FootPlanOptions {
     pub sole_gap: f64,
     /// Least height (m) of the sole's lowest point above the floor out of stance, once the
     /// foot has risen ([`FootPlanOptions::lift_s`]); the solve holds it as the sole's floor
-    /// ([`FootPlan::swing_floor`](super::FootPlan::swing_floor)). A foot is either planted or clear of the floor: the
+    /// (`FootPlan::swing_floor`). A foot is either planted or clear of the floor: the
     /// dynamics check and the report's skating on the floor count a sole within 1 cm as on
     /// it. (3.2 cm, held from the first frame off the floor, hiked ToddlerBot's short legs:
     /// its walk's jitter 12.5 rad/s² against 10.0 at 1.5 cm, `--gmr` 7.6.)
@@ -42,7 +42,7 @@ pub struct FootPlanOptions {
     pub lift_s: f64,
     /// A stance phase over which the source foot's yaw turns through more than this (rad,
     /// largest minus smallest) is a **pivot**: the planted foot turns with the source's, about
-    /// its toe point ([`RobotFoot::toe_point`](super::RobotFoot::toe_point)), which stays where the anchor puts it. Holding the mean yaw there
+    /// its toe point (`RobotFoot::toe_point`), which stays where the anchor puts it. Holding the mean yaw there
     /// (a dancer or a jumper turning on one foot) twisted the leg by half the turn: 45° on
     /// the LAFAN1 jumps, where the PM01's hip then went past its yaw range's middle and
     /// stayed there for the 2,000 frames that followed. A turning sole sweeps the floor, so

@@ -26,7 +26,7 @@ enum State {
     Upper,
 }
 
-/// Outcome of [`BoxQp::solve`].
+/// Outcome of `BoxQp::solve`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QpStatus {
     /// KKT conditions hold.
@@ -87,11 +87,6 @@ impl BoxQp {
         }
     }
 
-    #[must_use]
-    pub fn dim(&self) -> usize {
-        self.n
-    }
-
     /// Declares that `h[i][j] ≠ 0` only when `i` and `j` are equal or one is an ancestor of
     /// the other in the tree `parent` (parents have lower indices): true of a Hessian built
     /// from body Jacobians over MuJoCo's dof tree. The factorisation then follows MuJoCo's
@@ -111,6 +106,7 @@ impl BoxQp {
     }
 
     /// Whether variable `i` ended on one of its bounds (in the working set).
+    #[cfg(test)]
     #[must_use]
     pub fn is_bound(&self, i: usize) -> bool {
         self.state[i] != State::Free

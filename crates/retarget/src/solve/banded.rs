@@ -63,12 +63,6 @@ impl Banded {
         }
     }
 
-    /// Unknowns per frame.
-    #[must_use]
-    pub fn block(&self) -> usize {
-        self.n
-    }
-
     #[must_use]
     pub fn frames(&self) -> usize {
         self.frames

@@ -35,7 +35,6 @@ use bvh::Bvh;
 use fk::HumanMotion;
 use mjcf::Model;
 
-pub use banded::{Banded, NotPositiveDefinite};
 pub use dynamics::DynamicsOptions;
 pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
@@ -45,10 +44,8 @@ pub use options::{
 pub(crate) use prepare::build_solver;
 pub use prepare::task_specs;
 pub(crate) use prepare::{finite_pose, reject_divergence};
-pub use reweigh::reweigh;
 pub use schedule::ChunkOptions;
 pub use trajectory::TrajectoryOptions;
-pub use uncross::{LEGS_TOUCH, RESOLVE_LEAD_IN, RESOLVE_MARGIN, UNCROSS_SINK, UNCROSS_STUCK};
 
 use crate::config::IkConfig;
 use crate::motion::RobotMotion;

@@ -7,7 +7,7 @@ use crate::solver::{FrameDiagnostics, SolverOptions};
 use fk::FkOptions;
 use std::ops::Range;
 
-/// Which solve [`retarget_motion`](super::retarget_motion) runs.
+/// Which solve [`crate::Retargeter`] runs.
 // (One per solve, never in a loop or a collection: boxing the options would only make them
 // harder to build.)
 #[allow(clippy::large_enum_variant)]
@@ -40,17 +40,17 @@ pub struct PlausibleOptions {
     pub floor: f64,
     /// Hold the joints' speed limits (`mjcf::Joint::velocity_limit`) as hard bounds.
     pub speed_limits: SpeedLimits,
-    /// Keep the robot's own geoms apart ([`crate::constraints::SelfCollision`]).
+    /// Keep the robot's own geoms apart (`SelfCollision`).
     pub self_collision: SelfCollisionMode,
     /// Factor on the rotation weights of every task but the arms' (the trunk and the legs,
-    /// [`reweigh`](super::reweigh::reweigh)) where the config pins the pelvis at a height that disagrees with the
+    /// `reweigh`) where the config pins the pelvis at a height that disagrees with the
     /// robot's legs (its position weight above [`PlausibleOptions::root_position_weight_cap`],
     /// [`PlausibleOptions::pelvis_offset_range`]). GMR balanced
     /// its leg rotation weights (5–10) against feet that follow the human's; planted, the
     /// feet and the pelvis position decide the legs' posture and the legs' orientations gave
     /// way (the G1's hips and knees 2–4° further from their targets than with GMR's solve).
     pub trunk_rotation_scale: f64,
-    /// The root's position weight is at most this ([`reweigh`](super::reweigh::reweigh)) where the config's targets
+    /// The root's position weight is at most this (`reweigh`) where the config's targets
     /// disagree with the robot's legs. GMR weighs the G1's and the H1's pelvis position 100
     /// (its other configs 10–50): with the feet planted on the floor, that held the G1's
     /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
@@ -72,9 +72,9 @@ pub struct PlausibleOptions {
     /// the kick, and the backward pass, which reaches the kick from the normal stance, never
     /// does. Costs a second first pass, run on a second thread of rayon's pool.
     pub both_ways: bool,
-    /// Where the robot could not stand in a crossed stance ([`crate::feet::Crossing`]: in a
-    /// frame both feet are down, a planted foot [`UNCROSS_STUCK`](super::uncross::UNCROSS_STUCK) or further from its target,
-    /// the legs within [`LEGS_TOUCH`](super::uncross::LEGS_TOUCH) of each other and the pelvis [`UNCROSS_SINK`](super::uncross::UNCROSS_SINK) or more
+    /// Where the robot could not stand in a crossed stance (`Crossing`: in a
+    /// frame both feet are down, a planted foot `UNCROSS_STUCK` or further from its target,
+    /// the legs within `LEGS_TOUCH` of each other and the pelvis `UNCROSS_SINK` or more
     /// below its target), plan those steps again side by side and solve their frames again.
     /// The human crosses over in a crouch on the LAFAN1 walk (near frames 2990, 3240 and 3300,
     /// the right foot landing 11 cm to the left of the left one); the T1's legs are too thick
@@ -85,7 +85,7 @@ pub struct PlausibleOptions {
     /// targets that changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps,
     /// 504 frames of 7,184 with the margins and lead-in; 5 % more time).
     pub uncross_stuck: bool,
-    /// The trajectory solve over every frame ([`crate::solve::trajectory`]); 0 iterations:
+    /// The trajectory solve over every frame ([`crate::TrajectoryOptions`]); 0 iterations:
     /// the first pass alone.
     pub trajectory: crate::solve::trajectory::TrajectoryOptions,
     /// [`SolverOptions::max_extra_steps`] of this solve (GMR: 10).
@@ -155,16 +155,16 @@ impl PlausibleOptions {
     }
 }
 
-/// Options of [`retarget_bvh`](super::retarget_bvh) / [`retarget_motion`](super::retarget_motion).
+/// Options of a [`crate::Retargeter`]'s solve.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RetargetOptions {
     /// Subject height in metres; `None` uses the FK estimate (GMR assumes 1.75).
     pub human_height: Option<f64>,
     pub solver: SolverOptions,
     /// FK options. Their `roles` also name the source's feet for the contact phases
-    /// ([`crate::contact::human_foot_points`]); [`retarget_bvh`](super::retarget_bvh) adds the recognised ones.
+    /// (`human_foot_points`); the retargeter adds the recognised ones.
     pub fk: FkOptions,
-    /// Solve long clips as parallel chunks ([`retarget_motion_chunked`](super::retarget_motion_chunked)); `None`: one serial pass.
+    /// Solve long clips as parallel chunks; `None`: one serial pass.
     pub chunk: Option<super::ChunkOptions>,
     /// The default solve or GMR's.
     pub mode: SolveMode,
@@ -206,7 +206,7 @@ pub struct ClipDiagnostics {
     pub solve_seconds: f64,
     /// How far (m) the robot's pelvis stood above or below its target with the config's
     /// weights ([`PlausibleOptions::pelvis_offset_range`]; default solve with planted feet),
-    /// and the share of [`reweigh`](super::reweigh::reweigh)'s changes applied (0 to 1).
+    /// and the share of `reweigh`'s changes applied (0 to 1).
     pub pelvis_offset: Option<f64>,
     pub reweigh_share: f64,
     /// Frames of the crossed stances planned again uncrossed

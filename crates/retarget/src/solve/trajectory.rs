@@ -81,7 +81,7 @@ pub struct TrajectoryOptions {
     pub objective: Objective,
     /// With [`Objective::AllStages`], the factor on the cost of every stage but the last.
     pub earlier_stages: f64,
-    /// The dynamics term ([`super::dynamics`]).
+    /// The dynamics term ([`crate::DynamicsOptions`]).
     pub dynamics: DynamicsOptions,
 }
 

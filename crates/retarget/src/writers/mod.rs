@@ -3,7 +3,7 @@
 //!
 //! Every file is in the world frame of the pipeline: Z up, metres, radians. Quaternions are
 //! w-first in our own files (`.npz`, `.json`); the two formats that define x y z w (the
-//! Unitree CSV root and GMR's `root_rot`) are converted by [`xyzw_from_wxyz`] and nowhere else.
+//! Unitree CSV root and GMR's `root_rot`) are converted by `xyzw_from_wxyz` and nowhere else.
 //!
 //! Files are written atomically: into a temporary file next to the target, flushed to disk,
 //! then renamed over it. On error the temporary file is removed, so an interrupted or failed
@@ -25,6 +25,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::motion::RobotMotion;
+use crate::Error;
 
 pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
@@ -69,10 +70,6 @@ impl Format {
         }
     }
 }
-
-/// Errors of the writers, the `.npz` reader and the quality report: the crate's one
-/// [`crate::Error`].
-pub use crate::Error;
 
 /// Writes `motion` to `path` in `format` (by default the one of the extension), atomically.
 ///
@@ -139,7 +136,7 @@ pub fn npz_arrays(
 /// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
 /// `root_rot` use it. The only place where our files change quaternion order.
 #[must_use]
-pub const fn xyzw_from_wxyz(wxyz: [f64; 4]) -> [f64; 4] {
+pub(crate) const fn xyzw_from_wxyz(wxyz: [f64; 4]) -> [f64; 4] {
     [wxyz[1], wxyz[2], wxyz[3], wxyz[0]]
 }
 

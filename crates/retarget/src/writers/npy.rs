@@ -53,7 +53,7 @@ impl Array {
 
 /// The `.npy` bytes of `array`.
 #[must_use]
-pub fn encode(array: &Array) -> Vec<u8> {
+pub(crate) fn encode(array: &Array) -> Vec<u8> {
     let (descr, width) = match &array.data {
         ArrayData::F64(_) => ("<f8".to_owned(), 8),
         ArrayData::Bool(_) => ("|b1".to_owned(), 1),
