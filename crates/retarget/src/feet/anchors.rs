@@ -307,6 +307,31 @@ mod tests {
     }
 
     #[test]
+    fn a_fast_pivot_turns_on_the_ball_of_the_foot_with_its_heel_up() {
+        let lift = FootPlanOptions::default().pivot_heel_lift;
+        let heel_over_toe = |p: &Pose, foot: &RobotFoot| {
+            let z: Vec<f64> = foot.corners.iter().map(|c| (p.pos + quat(p) * c).z).collect();
+            (z[0] + z[1]) / 2.0 - (z[2] + z[3]) / 2.0
+        };
+        // 90° in 1 s: flat, the 20 cm sole's heel would sweep the floor at 0.3 m/s.
+        let (targets, foot) = turning_stance(std::f64::consts::FRAC_PI_2);
+        for (t, p) in targets.iter().enumerate() {
+            let up = heel_over_toe(p, &foot);
+            assert!((up - lift).abs() < 1e-9, "frame {t}: heel {up} m above the toe");
+            let low = targets[t].pos.z + (quat(p) * foot.corners[2]).z;
+            assert!(
+                (low - FootPlanOptions::default().clearance).abs() < 1e-9,
+                "frame {t}: toe at {low}"
+            );
+        }
+        // A slow pivot, 46° in 1 s (0.16 m/s, under `pivot_heel_speed`), lifts it part of the
+        // way.
+        let (slow, foot) = turning_stance(46f64.to_radians());
+        let up = heel_over_toe(&slow[15], &foot);
+        assert!(up > 0.0 && up < lift, "slow pivot: heel {up} m up");
+    }
+
+    #[test]
     fn only_a_frame_convention_is_turned_away() {
         let deg = f64::to_radians;
         assert!((convention_turn(deg(177.0)) - deg(180.0)).abs() < 1e-12, "Toddy's left calf");

@@ -148,7 +148,8 @@ pub fn plan_uncrossing(
     for (side, foot) in feet.iter().enumerate() {
         let Some(foot) = foot else { continue };
         let roll = roll_shares(&planted_mask[1 - side], roll_frames);
-        let planted = plant(foot, &anchors[side], &free[side], &free_yaw[side], &roll, options);
+        let planted =
+            plant(foot, &anchors[side], &free[side], &free_yaw[side], &roll, fps, options);
         plan.set_stance(foot, side, &planted, options.stance_weight, targets, slots);
         let held: Vec<bool> = planted.iter().map(Option::is_some).collect();
         let swings = swing(foot, &held, &free[side], targets, slots, fps, options);

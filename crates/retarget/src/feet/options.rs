@@ -61,6 +61,17 @@ pub struct FootPlanOptions {
     /// strike, toe off: the other foot carries the centre of pressure); the roll fades in and
     /// out over this time (s) at the double support's ends.
     pub roll_s: f64,
+    /// A pivoting foot turns on its ball: its heel rises this far (m) above its toe (the
+    /// pitch about the toe edge that lifts the sole's back end by it) where the foot turns
+    /// fast, so that the sole's back does not sweep the floor. Turning flat, a sole of length
+    /// `l` slides its heel at `ω l`: on the LAFAN1 jumps the G1's feet turned up to 450°/s on
+    /// the floor, and 95 % of the frames the report counted as skating on the floor were
+    /// such turns.
+    pub pivot_heel_lift: f64,
+    /// The heel is fully up ([`FootPlanOptions::pivot_heel_lift`]) where turning flat would
+    /// slide it faster than this (m/s), and down where the foot does not turn (smoothstep in
+    /// between).
+    pub pivot_heel_speed: f64,
 }
 
 impl Default for FootPlanOptions {
@@ -77,6 +88,8 @@ impl Default for FootPlanOptions {
             pivot_turn: 45f64.to_radians(),
             sole_band: 0.006,
             roll_s: 0.1,
+            pivot_heel_lift: 0.02,
+            pivot_heel_speed: 0.2,
         }
     }
 }

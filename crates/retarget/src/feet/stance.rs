@@ -1,6 +1,7 @@
 //! Standing: a planted foot stands on its whole sole ([`RobotFoot::within_band`]) except in
 //! double support, where it rolls with the human's (heel strike, toe off: `roll_shares`); a
-//! pivot's foot turns with the source's about its toe; the planted pose rests the sole's
+//! pivot's foot turns with the source's about its toe, on its ball where it turns fast (heel
+//! up); the planted pose rests the sole's
 //! lowest point on the floor at the anchor (`planted_pose`).
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -8,10 +9,12 @@
 // labels' lengths, which `plan` clips to it.
 #![allow(clippy::indexing_slicing)]
 
+use std::ops::Range;
+
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::anchors::{anchored, pivot, turn_of, Planted};
-use super::math::{quat, smoothstep};
+use super::math::{quat, smoothstep, wrap};
 use super::options::FootPlanOptions;
 use super::soles::RobotFoot;
 use crate::lie::Pose;
@@ -50,6 +53,33 @@ impl RobotFoot {
         }
         flat * UnitQuaternion::identity().slerp(&tilt, share)
     }
+
+    /// The sole's length (m): the spread of its bottom points along its forward direction.
+    fn length(&self) -> f64 {
+        let along = self.corners.iter().map(|c| self.forward.dot(c));
+        let (lo, hi) =
+            along.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        if lo < hi {
+            hi - lo
+        } else {
+            0.0
+        }
+    }
+
+    /// `rot` pitched toe-down about the foot's own left axis, so that the sole's back end
+    /// rises `lift` (m) above its front.
+    fn heel_up(&self, rot: &UnitQuaternion<f64>, lift: f64) -> UnitQuaternion<f64> {
+        let length = self.length();
+        if lift <= 0.0 || length <= lift {
+            return *rot;
+        }
+        let forward = rot * self.forward;
+        let left = Vector3::z().cross(&forward);
+        match nalgebra::Unit::try_new(left, 1e-9) {
+            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (lift / length).asin()) * rot,
+            None => *rot,
+        }
+    }
 }
 
 /// Per frame, how far a planted foot may roll as the human's does (1) or stands on its whole
@@ -72,13 +102,16 @@ pub(super) fn roll_shares(other: &[bool], roll_frames: f64) -> Vec<f64> {
 /// Per frame, the planted pose of `foot` in its stance `phases` (`None` out of stance): the
 /// flat foot at the phase's anchor (a pivot's turned with the source's yaw, `free_yaw`, about
 /// its toe), tilted as the `free` target within [`FootPlanOptions::sole_band`], rolled by
-/// `roll` towards the free target's tilt, resting at [`FootPlanOptions::clearance`].
+/// `roll` towards the free target's tilt, resting at [`FootPlanOptions::clearance`]. A
+/// pivot turns on the ball: as fast as it turns (at `fps` frames a second), it rolls no
+/// more with the human's foot and its heel rises ([`FootPlanOptions::pivot_heel_lift`]).
 pub(super) fn plant(
     foot: &RobotFoot,
     phases: &[Planted],
     free: &[Pose],
     free_yaw: &[f64],
     roll: &[f64],
+    fps: f64,
     options: &FootPlanOptions,
 ) -> Vec<Option<Pose>> {
     let mut planted = vec![None; free.len()];
@@ -89,12 +122,31 @@ pub(super) fn plant(
             let (xy, yaw) =
                 if pivots { (pivot(foot, xy, yaw, free_yaw[t]), free_yaw[t]) } else { (xy, yaw) };
             let tilt = quat(&free[t]);
-            let q = foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t]);
+            let turning = if pivots {
+                let rate = turn_rate(free_yaw, r.clone(), t, fps);
+                smoothstep((rate * foot.length() / options.pivot_heel_speed).min(1.0))
+            } else {
+                0.0
+            };
+            let q =
+                foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t] * (1.0 - turning));
+            let q = foot.heel_up(&q, turning * options.pivot_heel_lift);
             let rolled = Pose { quat: [q.w, q.i, q.j, q.k], pos: free[t].pos };
             planted[t] = Some(planted_pose(foot, &rolled, xy, yaw, options.clearance));
         }
     }
     planted
+}
+
+/// How fast (rad/s) the yaws turn at frame `t` of the phase `r` (central differences
+/// inside it, one-sided at its ends).
+fn turn_rate(yaws: &[f64], r: Range<usize>, t: usize, fps: f64) -> f64 {
+    let a = t.saturating_sub(1).max(r.start);
+    let b = (t + 1).min(r.end.saturating_sub(1)).min(yaws.len().saturating_sub(1));
+    if b <= a {
+        return 0.0;
+    }
+    (wrap(yaws[b] - yaws[a]) / (b - a) as f64 * fps).abs()
 }
 
 /// The planted pose: the free target's tilt with the anchor's yaw, rolled over the sole's
