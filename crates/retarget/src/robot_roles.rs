@@ -63,6 +63,12 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use crate::robot_names;
 use crate::Error;
 
+mod floating_base;
+mod limbs;
+mod sides;
+
+pub use floating_base::add_floating_base;
+
 /// A limb's knee or elbow is at least this share of the limb's span from its first hinge.
 const MIDDLE_AT: f64 = 0.35;
 /// ... and its axis within 60° of perpendicular to the bone (|cos| below this).
@@ -217,89 +223,6 @@ impl RobotRoles {
             );
         }
         out
-    }
-}
-
-/// Turns that may stand a lying model up, tried in this order (identity first): the file's
-/// up axis → +z.
-const STAND_UP: [(&str, [f64; 3], f64); 6] = [
-    ("", [1.0, 0.0, 0.0], 0.0),
-    ("+y", [1.0, 0.0, 0.0], std::f64::consts::FRAC_PI_2),
-    ("-y", [1.0, 0.0, 0.0], -std::f64::consts::FRAC_PI_2),
-    ("+x", [0.0, 1.0, 0.0], -std::f64::consts::FRAC_PI_2),
-    ("-x", [0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2),
-    ("-z", [1.0, 0.0, 0.0], std::f64::consts::PI),
-];
-
-/// Rule 0, before the others: a model without a free joint (an MJCF whose floating base the
-/// user's code adds, dm_control style) gets one on its root body ([`Model::root_body`]), the
-/// way a URDF gets one on loading. When the file stands along another axis than +z (dm_control's
-/// CMU humanoid is Y up), the base's rest pose turns it upright and puts its lowest point on
-/// the floor: of the six axis-aligned ups, the first under which [`RobotRoles::recognise`]
-/// finds a humanoid standing (+z first). Returns what was done, for the output to say once;
-/// `None` when the model had a free joint (or has no jointless root body to put one on).
-pub fn add_floating_base(model: &mut Model) -> Option<String> {
-    if model.has_free_joint() {
-        return None;
-    }
-    let root = model.root_body()?;
-    let body = model.bodies.get(root)?;
-    let (pos, quat) = (body.pos, body.quat);
-    let mut first = None;
-    for (up, axis, angle) in STAND_UP {
-        let turn =
-            UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(axis.into()), angle);
-        let mut candidate = model.clone();
-        let base = candidate.add_floating_base(turn * pos, turn * quat)?;
-        if !up.is_empty() {
-            lift_to_floor(&mut candidate, base.body);
-        }
-        let recognised = RobotRoles::recognise(&candidate).is_ok();
-        let stood = if up.is_empty() {
-            String::new()
-        } else {
-            format!(", turned so that the file's {up} is up (the model lies at qpos0)")
-        };
-        let note = format!(
-            "`{}` has no free joint: a floating base `{}` was added at body `{}` for \
-             retargeting{stood}",
-            model.name,
-            base.joint,
-            body_name(model, base.body)
-        );
-        if recognised {
-            *model = candidate;
-            return Some(note);
-        }
-        first.get_or_insert((candidate, note));
-    }
-    let (candidate, note) = first?;
-    *model = candidate;
-    Some(note)
-}
-
-/// Moves the free body `body` up or down so that the model's lowest point (geoms, else body
-/// origins) is at z = 0 at `qpos0`.
-fn lift_to_floor(model: &mut Model, body: usize) {
-    let mut data = Data::new(model);
-    model.kinematics(&model.qpos0, &mut data);
-    let mut low = f64::INFINITY;
-    for g in (0..model.geoms.len()).filter(|&g| model.geoms[g].body != 0) {
-        if let Some(p) = mjcf::geom_lowest_point(model, &data, g) {
-            low = low.min(p.z);
-        }
-    }
-    if !low.is_finite() {
-        low = data.xpos.iter().skip(1).map(|p| p.z).fold(f64::INFINITY, f64::min);
-    }
-    let Some(joint) = model.joints.iter().find(|j| j.body == body && j.kind == JointType::Free)
-    else {
-        return;
-    };
-    let adr = joint.qpos_adr + 2;
-    if let (true, Some(z)) = (low.is_finite(), model.qpos0.get_mut(adr)) {
-        *z -= low;
-        model.bodies[body].pos.z -= low;
     }
 }
 
@@ -682,88 +605,6 @@ impl<'m> Recogniser<'m> {
         Ok((chest, ends))
     }
 
-    /// Splits a limb chain at its knee or elbow (rule 5).
-    fn limb(&self, chain: Vec<usize>, what: &str, middle_name: &str) -> Result<Limb, Error> {
-        let end = *chain.last().unwrap_or(&0);
-        let all = self.hinges(&chain);
-        let Some(first) = all.first().copied() else {
-            return Err(self
-                .not_humanoid(format!("the {what} ending in `{}` has no joint", self.name(end))));
-        };
-        let root = first.anchor;
-        let end_point = self.end_point(&chain, root);
-        let span = (end_point - root).norm();
-        let middle = all.iter().enumerate().skip(1).find(|(k, h)| {
-            // The bone leading to the hinge: from the last anchor before it that is elsewhere.
-            let from = all[..*k]
-                .iter()
-                .rev()
-                .map(|p| p.anchor)
-                .find(|a| (h.anchor - a).norm() > 0.01 * span)
-                .unwrap_or(root);
-            // Joints sit beside the bone line on some robots (Talos' first shoulder joint is
-            // inboard, HighTorque Hi's elbow outboard): across either line will do.
-            let across = |a: Vector3<f64>| {
-                let bone = (h.anchor - a).try_normalize(1e-12).unwrap_or_else(Vector3::zeros);
-                h.axis.dot(&bone).abs() < PERPENDICULAR_COS
-            };
-            (h.anchor - root).norm() >= MIDDLE_AT * span && (across(from) || across(root))
-        });
-        let Some((k, middle)) = middle else {
-            return Err(self.not_humanoid(format!(
-                "the {what} ending in `{}` has no {middle_name}: no hinge across the limb \
-                 beyond {:.0} % of its length",
-                self.name(end),
-                MIDDLE_AT * 100.0
-            )));
-        };
-        let mut distal: Vec<Hinge> = Vec::new();
-        for h in &all[k + 1..] {
-            // A body with several jointed branches (fingers) ends the chain after it.
-            if distal.last().is_some_and(|d| d.body != h.body && self.jointed_branches(d.body) > 1)
-            {
-                break;
-            }
-            distal.push(*h);
-        }
-        let end_body = (distal.is_empty() && end != middle.body).then_some(end);
-        Ok(Limb {
-            chain,
-            proximal: all[..k].to_vec(),
-            middle: *middle,
-            distal,
-            end_body,
-            end_point,
-        })
-    }
-
-    /// Rule 2's wheel: an unlimited hinge whose axis is horizontal and across the direction
-    /// of travel (within 30° of the hips' left-right axis), carrying a round geom (a sphere,
-    /// or a cylinder, capsule or ellipsoid turning about its own axis) whose lowest point is
-    /// on the floor (within 2 % of the robot's height of the lowest point). An unlimited
-    /// ankle roll (ROBOTIS OP3's) is a joint without limits, not a wheel.
-    fn is_wheel(&self, hinge: &Hinge, across: Vector3<f64>) -> bool {
-        let floor = self.lowest.iter().copied().fold(f64::INFINITY, f64::min);
-        if hinge.range.is_some() || hinge.axis.dot(&across).abs() < WHEEL_AXIS_COS {
-            return false;
-        }
-        let bodies = self.model.subtree(hinge.body);
-        self.model.geoms.iter().enumerate().any(|(g, geom)| {
-            let round = match geom.kind {
-                mjcf::GeomType::Sphere => true,
-                mjcf::GeomType::Cylinder | mjcf::GeomType::Capsule | mjcf::GeomType::Ellipsoid => {
-                    let own_axis = self.data.geom_xmat[g].column(2).into_owned();
-                    own_axis.dot(&hinge.axis).abs() > WHEEL_AXIS_COS
-                }
-                _ => false,
-            };
-            round
-                && bodies.contains(&geom.body)
-                && mjcf::geom_lowest_point(self.model, &self.data, g)
-                    .is_some_and(|p| p.z - floor <= 0.02 * self.height)
-        })
-    }
-
     /// Length of the tree path from `top` down to `bottom` (sum of body-to-body distances).
     fn path_length(&self, top: usize, bottom: usize) -> f64 {
         let mut previous = self.data.xpos[top];
@@ -881,122 +722,6 @@ impl<'m> Recogniser<'m> {
             }
             None => Some((top, "the highest body above the shoulders".to_owned())),
         }
-    }
-
-    /// Forward at `qpos0` (rule 6): ⟂ the hips' axis, sign from the knees and the feet.
-    fn facing(&self, legs: &[Limb], across: Vector3<f64>) -> Option<(Vector3<f64>, String)> {
-        let ahead = across.cross(&Vector3::z());
-        let (mut knees, mut toes) = (0.0, 0.0);
-        for leg in legs {
-            let knee = leg.middle;
-            if let Some([lo, hi]) = knee.range {
-                let flex = if hi.abs() >= lo.abs() { 1.0 } else { -1.0 };
-                let ankle = leg.distal.first().map_or(leg.end_point, |h| h.anchor);
-                let moves = knee.axis.cross(&(ankle - knee.anchor)) * flex;
-                knees -= moves.dot(&ahead).signum() * f64::from(u8::from(moves.norm() > 1e-9));
-            }
-            let ankle = joint_centre(&leg.distal);
-            let foot_root = leg.distal.first().map_or(leg.middle.body, |h| h.body);
-            let mut reach = Vector3::zeros();
-            for b in self.model.subtree(foot_root) {
-                reach += self.data.xpos[b] - ankle;
-            }
-            for (g, geom) in self.model.geoms.iter().enumerate() {
-                if self.model.is_ancestor_or_self(foot_root, geom.body) && geom.kind.is_primitive()
-                {
-                    reach += self.data.geom_xpos[g] - ankle;
-                }
-            }
-            let r = reach.dot(&ahead);
-            if r.abs() > 1e-6 {
-                toes += r.signum();
-            }
-        }
-        // A knee's flexion is unambiguous; the feet's shape only breaks its ties.
-        let vote = 2.0 * knees + toes;
-        if vote == 0.0 {
-            return None;
-        }
-        let forward = ahead * vote.signum();
-        let how = format!(
-            "({:+.2}, {:+.2}, 0): knees bending backward {:+}, feet reaching forward {:+} (votes \
-             of the two legs)",
-            forward.x,
-            forward.y,
-            knees * vote.signum(),
-            toes * vote.signum()
-        );
-        Some((forward, how))
-    }
-
-    /// Whether the first leg and arm of the lists are the left ones, and why (rule 6).
-    fn sides(&self, legs: &[Limb], arms: &[Limb], forward: Vector3<f64>) -> (bool, String) {
-        let left = Vector3::z().cross(&forward);
-        let geometry_legs = (legs[0].root() - legs[1].root()).dot(&left) > 0.0;
-        let geometry_arms = (arms[0].root() - arms[1].root()).dot(&left) > 0.0;
-        match self.named_left_first(legs, arms) {
-            Some(l) => {
-                let agree = if l == geometry_legs && l == geometry_arms {
-                    "geometry agrees"
-                } else {
-                    "geometry disagrees: names win"
-                };
-                (l, format!("names ({agree})"))
-            }
-            _ if geometry_legs == geometry_arms => {
-                (geometry_legs, "geometry: left = up × forward".to_owned())
-            }
-            _ => (geometry_legs, "geometry of the legs (the arms cross over)".to_owned()),
-        }
-    }
-
-    /// Whether the first leg and arm are the left ones by their names: `Some` when both legs'
-    /// and both arms' names state opposite sides, consistently.
-    fn named_left_first(&self, legs: &[Limb], arms: &[Limb]) -> Option<bool> {
-        let named = |limb: &Limb| -> i32 {
-            limb.chain.iter().map(|&b| robot_names::side_of(&self.name(b))).sum::<i32>().signum()
-        };
-        let by_names = |a: &Limb, b: &Limb| match (named(a), named(b)) {
-            (1, -1) => Some(true),
-            (-1, 1) => Some(false),
-            _ => None,
-        };
-        match (by_names(&legs[0], &legs[1]), by_names(&arms[0], &arms[1])) {
-            (Some(l), Some(a)) if l == a => Some(l),
-            _ => None,
-        }
-    }
-
-    /// The sole under a foot (rule 7).
-    fn sole(&self, roles: &BTreeMap<Role, RobotRole>, leg: &Limb, side: Side) -> Sole {
-        let body = roles.get(&Role::of(Part::Foot, side)).map_or(leg.middle.body, |r| r.body);
-        let bodies = self.model.subtree(body);
-        let mut geoms: Vec<(usize, Vector3<f64>)> = self
-            .model
-            .geoms
-            .iter()
-            .enumerate()
-            .filter(|(_, g)| {
-                bodies.contains(&g.body)
-                    && g.kind.is_primitive()
-                    && (g.contype != 0 || g.conaffinity != 0)
-            })
-            .filter_map(|(i, _)| Some((i, mjcf::geom_lowest_point(self.model, &self.data, i)?)))
-            .collect();
-        let named = if side == Side::Left { "left_sole" } else { "right_sole" };
-        geoms.sort_by(|a, b| {
-            let n = |g: usize| self.model.geoms[g].name != named;
-            n(a.0).cmp(&n(b.0)).then(a.1.z.total_cmp(&b.1.z))
-        });
-        let lowest = geoms
-            .iter()
-            .map(|(_, p)| *p)
-            .min_by(|a, b| a.z.total_cmp(&b.z))
-            .or_else(|| {
-                bodies.iter().map(|&b| self.data.xpos[b]).min_by(|a, b| a.z.total_cmp(&b.z))
-            })
-            .unwrap_or_else(Vector3::zeros);
-        Sole { body, geoms: geoms.into_iter().map(|(g, _)| g).collect(), lowest }
     }
 }
 
