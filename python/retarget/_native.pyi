@@ -73,13 +73,12 @@ class Motion:
     @property
     def solve_seconds(self) -> float: ...
     @property
-    def reweighing(self) -> Tuple[Optional[float], float]:
-        """Pelvis height off its target with the config's weights (m, or None) and the
-        share of the default solve's trunk-and-leg reweighing applied."""
-    @property
-    def uncrossed(self) -> List[Tuple[int, int]]:
-        """Frames (first, last) of the human's crossed steps the robot could not stand in,
-        planned side by side and solved again (default solve; empty otherwise)."""
+    def stages(self) -> Dict[str, Dict[str, Any]]:
+        """What the default solve's stages said, ``{stage: {key: value}}`` in the order they
+        ran (only stages with something to say), each with its one-line ``"summary"``:
+        ``"reweigh"`` (``pelvis_offset`` in m, ``share`` 0 to 1) and ``"uncross"``
+        (``stretches``: frames (first, last) of the human's crossed steps the robot could not
+        stand in, planned side by side and solved again)."""
     @property
     def backward(self) -> Tuple[int, int]:
         """Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise)

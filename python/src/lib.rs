@@ -19,7 +19,7 @@ use pyo3::types::{PyDict, PyList, PyMapping};
 
 use retarget::writers::npy::{Array, ArrayData};
 use retarget::writers::Format;
-use retarget::{ClipDiagnostics, HumanFrame, RetargetOptions, RobotMotion};
+use retarget::{ClipDiagnostics, HumanFrame, RetargetOptions, RobotMotion, StageValue};
 
 pyo3::create_exception!(
     _native,
@@ -408,6 +408,17 @@ impl Motion {
     }
 }
 
+/// One value of a stage's report as Python: float, int, list of ``(first, last)`` or str.
+fn stage_value<'py>(py: Python<'py>, value: &StageValue) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match value {
+        StageValue::Number(x) => x.into_pyobject(py)?.into_any(),
+        StageValue::Count(n) => n.into_pyobject(py)?.into_any(),
+        StageValue::Ranges(ranges) => PyList::new(py, ranges)?.into_any(),
+        StageValue::Text(text) => text.into_pyobject(py)?.into_any(),
+        _ => py.None().into_bound(py),
+    })
+}
+
 /// An npz array as numpy: float64 and bool arrays moved (no copy) and reshaped (a view),
 /// read-only; strings as a numpy unicode array.
 fn to_numpy(py: Python<'_>, array: Array) -> PyResult<Bound<'_, PyAny>> {
@@ -549,19 +560,24 @@ impl Motion {
         self.diag.solve_seconds
     }
 
-    /// How far (m) the robot's pelvis stood above or below its target with the config's
-    /// weights (``None`` where it was not measured: GMR's solve, streams, configs that do not
-    /// pin the pelvis), and the share (0 to 1) of the default solve's reweighing applied.
+    /// What the default solve's stages said about the clip, ``{stage: {key: value}}`` in the
+    /// order they ran, only stages with something to say: each with its one-line
+    /// ``"summary"`` (as the main command prints it) and its values (numbers as float or int,
+    /// frame stretches as lists of ``(first, last)``). ``"reweigh"``: ``pelvis_offset`` (m,
+    /// the pelvis off its target with the config's weights) and ``share`` (0 to 1);
+    /// ``"uncross"``: ``stretches``, the crossed steps planned side by side and solved again.
     #[getter]
-    fn reweighing(&self) -> (Option<f64>, f64) {
-        (self.diag.pelvis_offset, self.diag.reweigh_share)
-    }
-
-    /// Frames ``(first, last)`` of the crossed steps of the human's that the robot could not
-    /// stand in, planned uncrossed and solved again (default solve; empty otherwise).
-    #[getter]
-    fn uncrossed(&self) -> Vec<(usize, usize)> {
-        self.diag.uncrossed.iter().map(|r| (r.start, r.end - 1)).collect()
+    fn stages<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let out = PyDict::new(py);
+        for report in &self.diag.stages {
+            let values = PyDict::new(py);
+            values.set_item("summary", &report.summary)?;
+            for (key, value) in &report.values {
+                values.set_item(key, stage_value(py, value)?)?;
+            }
+            out.set_item(report.stage, values)?;
+        }
+        Ok(out)
     }
 
     /// Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise) and

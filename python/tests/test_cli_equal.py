@@ -48,8 +48,9 @@ def test_arrays_are_read_only_views(walk_outputs):
     with pytest.raises(ValueError):
         qpos[0, 0] = 1.0
     assert "config configs/bvh_lafan1_to_unitree_g1.json" in motion.inferred
-    offset, share = motion.reweighing  # GMR's G1 config holds the pelvis under the legs
-    assert 0.01 < offset < 0.03 and share > 0.5, motion.reweighing
+    reweigh = motion.stages["reweigh"]  # GMR's G1 config holds the pelvis under the legs
+    offset, share = reweigh["pelvis_offset"], reweigh["share"]
+    assert 0.01 < offset < 0.03 and share > 0.5, motion.stages
     height, source = motion.human_height
     assert 1.6 < height < 1.9 and source
 

@@ -250,24 +250,8 @@ fn print_summary(
     if !diag.human_inferred.is_empty() {
         println!("inferred: {}", diag.human_inferred);
     }
-    if let Some(offset) = diag.pelvis_offset {
-        println!(
-            "default solve: the pelvis stands {:.1} cm off its target with the config's \
-             weights; trunk and leg weights reweighed {:.0} %",
-            100.0 * offset,
-            100.0 * diag.reweigh_share
-        );
-    }
-    if !diag.uncrossed.is_empty() {
-        let list: Vec<String> =
-            diag.uncrossed.iter().map(|r| format!("{}-{}", r.start, r.end - 1)).collect();
-        let n = list.len();
-        println!(
-            "default solve: the robot could not stand in {n} crossed step{} of the human's \
-             (frames {}); planned uncrossed and solved again",
-            if n == 1 { "" } else { "s" },
-            list.join(", ")
-        );
+    for stage in &diag.stages {
+        println!("default solve: {}", stage.summary);
     }
     if both_ways {
         let (backward, stretches) = diag.from_backward();

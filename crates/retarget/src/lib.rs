@@ -73,8 +73,9 @@
 //!   [`MarkerConfig`] (C3D markers: [`MarkerHeight`], [`MarkerMotion`]), [`FbxClip`], and
 //!   the robot's recognised [`RobotRoles`] ([`RobotRole`], [`Sole`]).
 //! - **Outputs**: [`RobotMotion`] (with its [`FootContacts`] and [`TrackedTargets`]),
-//!   [`ClipDiagnostics`] of [`FrameDiagnostics`], [`resample`] to another frame rate,
-//!   [`blocked_limbs`] ([`BlockedLimb`], [`PinnedJoint`]): where a limb could not follow.
+//!   [`ClipDiagnostics`] of [`FrameDiagnostics`] and [`StageReport`]s ([`StageValue`]),
+//!   [`resample`] to another frame rate, [`blocked_limbs`] ([`BlockedLimb`], [`PinnedJoint`]):
+//!   where a limb could not follow.
 //! - **GMR's BVH loader**, for code written against GMR: [`load_bvh_gmr`], [`GmrBvhFormat`],
 //!   [`GMR_HUMAN_HEIGHT`].
 //! - **Modules**: [`writers`] (npz, csv, pkl, json; reading our npz back), [`report`] (the
@@ -142,7 +143,7 @@ pub use robot_roles::{RobotRole, RobotRoles, Sole};
 pub use follow::{blocked_limbs, Blocked as BlockedLimb, PinnedJoint};
 pub use motion::{FootContacts, RobotMotion, TrackedTargets};
 pub use resample::resample;
-pub use solve::ClipDiagnostics;
+pub use solve::{ClipDiagnostics, StageReport, StageValue};
 pub use solver::FrameDiagnostics;
 
 // GMR's BVH loader, for code written against GMR.

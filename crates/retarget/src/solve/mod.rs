@@ -13,7 +13,9 @@
 //!
 //! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
 //! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
-//! 2 and 5 with GMR's solver and nothing else.
+//! 2 and 5 with GMR's solver and nothing else. A stage with something to say about the clip
+//! pushes a [`StageReport`] (named after its file: `reweigh`, `uncross`) onto
+//! [`ClipDiagnostics::stages`].
 
 mod banded;
 mod contacts;
@@ -39,7 +41,7 @@ pub use dynamics::DynamicsOptions;
 pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
     ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
-    SpeedLimits,
+    SpeedLimits, StageReport, StageValue,
 };
 pub(crate) use prepare::build_solver;
 pub use prepare::task_specs;

@@ -5,7 +5,7 @@
 
 use crate::solver::{FrameDiagnostics, SolverOptions};
 use fk::FkOptions;
-use std::ops::Range;
+use std::collections::BTreeMap;
 
 /// Which solve [`crate::Retargeter`] runs.
 // (One per solve, never in a loop or a collection: boxing the options would only make them
@@ -204,14 +204,42 @@ pub struct ClipDiagnostics {
     pub human_inferred: String,
     /// Wall time of the IK alone (seconds).
     pub solve_seconds: f64,
-    /// How far (m) the robot's pelvis stood above or below its target with the config's
-    /// weights ([`PlausibleOptions::pelvis_offset_range`]; default solve with planted feet),
-    /// and the share of `reweigh`'s changes applied (0 to 1).
-    pub pelvis_offset: Option<f64>,
-    pub reweigh_share: f64,
-    /// Frames of the crossed stances planned again uncrossed
-    /// ([`PlausibleOptions::uncross_stuck`]), in order.
-    pub uncrossed: Vec<Range<usize>>,
+    /// What the default solve's stages say about the clip ([`StageReport`]), in the order
+    /// they ran; only stages that have something to say (the reweighing where the config's
+    /// pelvis disagrees with the robot's legs, the uncrossing where it solved steps again).
+    pub stages: Vec<StageReport>,
+}
+
+/// What one stage of the solve says about a clip: its name, one line for people, and the
+/// numbers behind that line for programs. The main command prints each `summary` after
+/// `default solve: `; Python gives them as `Motion.stages`, `{stage: {key: value}}` with the
+/// summary under `"summary"`.
+///
+/// A stage that reports pushes one of these onto the solve's reports in its own file
+/// (`Prepared::reports`, as `solve/reweigh.rs` and `solve/uncross.rs` do); the CLI, Python
+/// and [`ClipDiagnostics`] collect them without knowing the stage.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct StageReport {
+    /// The stage's name: its file in `solve/` without `.rs` (`"reweigh"`, `"uncross"`).
+    pub stage: &'static str,
+    /// One line, no trailing newline (e.g. `the pelvis stands 1.3 cm off its target with the
+    /// config's weights; trunk and leg weights reweighed 87 %`).
+    pub summary: String,
+    /// The numbers the summary says, by key (documented in the stage's file).
+    pub values: BTreeMap<&'static str, StageValue>,
+}
+
+/// One value of a [`StageReport`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub enum StageValue {
+    /// A measurement, in SI units (m, s, rad) or a share from 0 to 1.
+    Number(f64),
+    /// How many of something.
+    Count(usize),
+    /// Stretches of frames, `(first, last)` with the last frame included.
+    Ranges(Vec<(usize, usize)>),
+    Text(String),
 }
 
 impl ClipDiagnostics {

@@ -7,12 +7,12 @@
 // `HumanMotion::validate` first.
 #![allow(clippy::indexing_slicing)]
 
-use std::ops::Range;
-
 use mjcf::{JointType, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::{ClipDiagnostics, RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits};
+use super::{
+    ClipDiagnostics, RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits, StageReport,
+};
 use crate::config::IkConfig;
 use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
@@ -40,16 +40,15 @@ pub(crate) struct Prepared<'a> {
     /// Foot bodies and per-frame weight factors (default mode).
     pub(super) plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
     /// The targets before the foot plan rewrote them (default mode, planted feet), to plan
-    /// again from ([`Prepared::uncross_stuck`]), and the stance overlaps uncrossed.
+    /// again from ([`Prepared::uncross_stuck`]).
     pub(super) unplanned: Option<Vec<Pose>>,
-    pub(super) uncrossed: Vec<Range<usize>>,
     pub(super) fps: f64,
     pub(super) height: f64,
     /// Target slot of the human root.
     pub(super) root_target: usize,
-    /// [`ClipDiagnostics::pelvis_offset`] and [`ClipDiagnostics::reweigh_share`].
-    pub(super) pelvis_offset: Option<f64>,
-    pub(super) reweigh_share: f64,
+    /// What the stages that ran have to say, in order ([`ClipDiagnostics::stages`]): each
+    /// stage pushes its own [`StageReport`].
+    pub(super) reports: Vec<StageReport>,
 }
 
 /// Solved frames of a range.
@@ -97,12 +96,10 @@ impl<'a> Prepared<'a> {
             contacts: None,
             plan: None,
             unplanned: None,
-            uncrossed: Vec::new(),
             fps: human.fps,
             height,
             root_target: map.root,
-            pelvis_offset: None,
-            reweigh_share: 0.0,
+            reports: Vec::new(),
         };
         Ok(prepared)
     }
@@ -212,9 +209,7 @@ impl<'a> Prepared<'a> {
             human_height_source: "given".to_owned(),
             human_inferred: String::new(),
             solve_seconds,
-            pelvis_offset: self.pelvis_offset,
-            reweigh_share: self.reweigh_share,
-            uncrossed: self.uncrossed.clone(),
+            stages: self.reports.clone(),
         };
         (motion, diag)
     }

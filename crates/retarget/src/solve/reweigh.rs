@@ -8,12 +8,13 @@
 // `HumanMotion::validate` first.
 #![allow(clippy::indexing_slicing)]
 
+use std::collections::BTreeMap;
 use std::ops::Range;
 
 use mjcf::Model;
 
 use super::prepare::Prepared;
-use super::{PlausibleOptions, SolveMode};
+use super::{PlausibleOptions, SolveMode, StageReport, StageValue};
 use crate::solver::TaskSpec;
 use crate::Error;
 
@@ -44,7 +45,7 @@ impl<'a> Prepared<'a> {
         let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
         let share = t * t * (3.0 - 2.0 * t);
         reweigh(&mut self.stages, self.model, self.root_target, options, share);
-        (self.pelvis_offset, self.reweigh_share) = (Some(offset), share);
+        self.reports.push(report(offset, share));
         Ok(())
     }
 
@@ -89,6 +90,25 @@ impl<'a> Prepared<'a> {
         }
         let median = crate::report::percentile(&heights, 0.5);
         Ok(Some(median.abs()))
+    }
+}
+
+/// What the reweighing says of a clip whose pelvis stood `offset` (m) above or below its
+/// target with the config's weights, `share` (0 to 1) of [`reweigh`]'s changes applied:
+/// values `pelvis_offset` (m) and `share`.
+fn report(offset: f64, share: f64) -> StageReport {
+    StageReport {
+        stage: "reweigh",
+        summary: format!(
+            "the pelvis stands {:.1} cm off its target with the config's weights; trunk and \
+             leg weights reweighed {:.0} %",
+            100.0 * offset,
+            100.0 * share
+        ),
+        values: BTreeMap::from([
+            ("pelvis_offset", StageValue::Number(offset)),
+            ("share", StageValue::Number(share)),
+        ]),
     }
 }
 
@@ -149,4 +169,23 @@ fn arm_roots(model: &Model, roles: &crate::RobotRoles) -> Option<[usize; 2]> {
         (body != 0).then_some(body)
     };
     Some([root(fk::Role::LeftUpperArm)?, root(fk::Role::RightUpperArm)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report's summary says what its values hold, as the main command prints it.
+    #[test]
+    fn the_report_says_the_offset_and_the_share() {
+        let r = report(0.013, 0.87);
+        assert_eq!(r.stage, "reweigh");
+        assert_eq!(r.values["pelvis_offset"], StageValue::Number(0.013));
+        assert_eq!(r.values["share"], StageValue::Number(0.87));
+        assert_eq!(
+            r.summary,
+            "the pelvis stands 1.3 cm off its target with the config's weights; trunk and leg \
+             weights reweighed 87 %"
+        );
+    }
 }

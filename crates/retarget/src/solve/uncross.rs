@@ -7,10 +7,11 @@
 // `HumanMotion::validate` first.
 #![allow(clippy::indexing_slicing)]
 
+use std::collections::BTreeMap;
 use std::ops::Range;
 
 use super::prepare::{Prepared, Solved};
-use super::SolveMode;
+use super::{SolveMode, StageReport, StageValue};
 use crate::solver::FrameDiagnostics;
 use crate::Error;
 
@@ -170,7 +171,48 @@ impl<'a> Prepared<'a> {
         let frames_n = self.num_frames();
         let first = (0..frames_n).find(differs)?;
         let last = (0..frames_n).rev().find(differs)?;
-        (self.targets, self.plan, self.uncrossed) = (targets, Some((feet, plan)), overlaps);
+        (self.targets, self.plan) = (targets, Some((feet, plan)));
+        self.reports.push(report(&overlaps));
         Some(first..last + 1)
+    }
+}
+
+/// What the uncrossing says of a clip whose crossed stances `overlaps` (frames, in order)
+/// it planned again side by side: value `stretches`, their `(first, last)` frames.
+fn report(overlaps: &[Range<usize>]) -> StageReport {
+    let stretches: Vec<(usize, usize)> =
+        overlaps.iter().map(|r| (r.start, r.end.saturating_sub(1))).collect();
+    let list: Vec<String> = stretches.iter().map(|(a, b)| format!("{a}-{b}")).collect();
+    let n = list.len();
+    StageReport {
+        stage: "uncross",
+        summary: format!(
+            "the robot could not stand in {n} crossed step{} of the human's (frames {}); \
+             planned uncrossed and solved again",
+            if n == 1 { "" } else { "s" },
+            list.join(", ")
+        ),
+        values: BTreeMap::from([("stretches", StageValue::Ranges(stretches))]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report's summary says what its values hold, as the main command prints it.
+    #[test]
+    fn the_report_says_its_stretches() {
+        let one = report(&[Range { start: 392, end: 401 }]);
+        assert_eq!(one.stage, "uncross");
+        assert_eq!(one.values["stretches"], StageValue::Ranges(vec![(392, 400)]));
+        assert_eq!(
+            one.summary,
+            "the robot could not stand in 1 crossed step of the human's (frames 392-400); \
+             planned uncrossed and solved again"
+        );
+        let two = report(&[90..97, 392..401]);
+        assert_eq!(two.values["stretches"], StageValue::Ranges(vec![(90, 96), (392, 400)]));
+        assert!(two.summary.contains("in 2 crossed steps of the human's (frames 90-96, 392-400)"));
     }
 }
