@@ -61,13 +61,13 @@ fn options_for(mode: &str, human_height: Option<f64>) -> PyResult<RetargetOption
         "default" | "plausible" => RetargetOptions::default(),
         "gmr" => RetargetOptions::gmr(),
         "causal" => RetargetOptions::causal(),
-        "both_ways" => RetargetOptions {
-            mode: retarget::SolveMode::Plausible(retarget::PlausibleOptions {
-                both_ways: true,
-                ..Default::default()
-            }),
-            ..RetargetOptions::default()
-        },
+        "both_ways" => {
+            let mut plausible = retarget::PlausibleOptions::default();
+            plausible.both_ways = true;
+            let mut options = RetargetOptions::default();
+            options.mode = retarget::SolveMode::Plausible(plausible);
+            options
+        }
         other => {
             return Err(PyValueError::new_err(format!(
                 "mode {other:?}: expected \"default\", \"gmr\", \"causal\" or \"both_ways\""

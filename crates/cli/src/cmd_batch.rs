@@ -92,14 +92,11 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     if let Some(fps) = args.fps.filter(|f| !(f.is_finite() && *f > 0.0)) {
         bail!("--fps {fps}: expected a positive rate");
     }
-    let options = RetargetOptions {
-        human_height: args.human_height,
-        chunk: args
-            .chunk_frames
-            .map(|frames| retarget::ChunkOptions { frames, lead_in: args.lead_in }),
-        mode: crate::cmd_retarget::solve_mode(args.gmr, args.both_ways),
-        ..RetargetOptions::default()
-    };
+    let mut options = RetargetOptions::default();
+    options.human_height = args.human_height;
+    options.chunk =
+        args.chunk_frames.map(|frames| retarget::ChunkOptions { frames, lead_in: args.lead_in });
+    options.mode = crate::cmd_retarget::solve_mode(args.gmr, args.both_ways);
     let mut job = Job::load(&robot, args.config.as_deref(), options, &args.format)?;
     job.fps = args.fps;
     job.body_models = args.smpl.models();
@@ -239,10 +236,11 @@ impl Job {
                 .with_context(|| format!("{}: retargeting", src.display()))?;
             (motion, diag, chosen.config)
         };
-        let report_options = retarget::report::ReportOptions {
-            position_targets: Some(config.position_targets()),
-            root_target: Some(config.robot_root_name.clone()),
-            ..retarget::report::ReportOptions::default()
+        let report_options = {
+            let mut o = retarget::report::ReportOptions::default();
+            o.position_targets = Some(config.position_targets());
+            o.root_target = Some(config.robot_root_name.clone());
+            o
         };
         let quality = self.retargeter.report(&motion, &report_options)?;
         let model = self.retargeter.model();

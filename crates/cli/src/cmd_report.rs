@@ -73,17 +73,15 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
     };
     let position_targets = config.as_ref().map(retarget::IkConfig::position_targets);
     let robot = if model.name.is_empty() { "(unnamed)" } else { model.name.as_str() };
-    let opts = ReportOptions {
-        feet: args.feet.map(|f| [f[0].clone(), f[1].clone()]),
-        ground_height: args.ground,
-        contact_height: args.contact_height,
-        contact_speed: args.contact_speed,
-        slide_speed: args.slide_speed,
-        joint_velocity_limit: args.velocity_limit,
-        position_targets,
-        root_target: config.map(|c| c.robot_root_name),
-        ..ReportOptions::default()
-    };
+    let mut opts = ReportOptions::default();
+    opts.feet = args.feet.map(|f| [f[0].clone(), f[1].clone()]);
+    opts.ground_height = args.ground;
+    opts.contact_height = args.contact_height;
+    opts.contact_speed = args.contact_speed;
+    opts.slide_speed = args.slide_speed;
+    opts.joint_velocity_limit = args.velocity_limit;
+    opts.position_targets = position_targets;
+    opts.root_target = config.map(|c| c.robot_root_name);
     let rep = report(&motion, &model, &opts)
         .with_context(|| format!("{}: robot {robot}", args.motion.display()))?;
     if let Some(path) = &args.json {

@@ -89,7 +89,9 @@ pub fn solve_mode(gmr: bool, both_ways: bool) -> SolveMode {
     if gmr {
         SolveMode::Gmr
     } else {
-        SolveMode::Plausible(retarget::PlausibleOptions { both_ways, ..Default::default() })
+        let mut plausible = retarget::PlausibleOptions::default();
+        plausible.both_ways = both_ways;
+        SolveMode::Plausible(plausible)
     }
 }
 
@@ -121,11 +123,12 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
     let mode = solve_mode(args.gmr, args.both_ways);
     let chunk =
         args.chunk_frames.map(|frames| retarget::ChunkOptions { frames, lead_in: args.lead_in });
-    let options = RetargetOptions {
-        human_height: args.human_height,
-        mode,
-        chunk,
-        ..RetargetOptions::default()
+    let options = {
+        let mut o = RetargetOptions::default();
+        o.human_height = args.human_height;
+        o.mode = mode;
+        o.chunk = chunk;
+        o
     };
     let mut retargeter = Retargeter::new(&robot)?.with_options(options);
     for note in retargeter.robot_notes() {

@@ -28,6 +28,7 @@ use crate::motion::FootContacts;
 
 /// Tunables of the contact detection (`detect`); lengths in metres, speeds in m/s, in the source's (human) scale.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ContactOptions {
     pub height_on: f64,
     pub height_off: f64,

@@ -175,6 +175,7 @@ use feet::{floating, foot_heights, foot_report, skating, stance};
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct ReportOptions {
     /// Foot bodies `[left, right]`; `None`: the feet the default solve plants
     /// ([`crate::feet::detect_feet`]).

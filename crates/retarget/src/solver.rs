@@ -40,6 +40,7 @@ const SPEED_MARGIN: f64 = 0.999;
 
 /// Tunables of the solver. [`Default`] reproduces GMR.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct SolverOptions {
     /// Global Levenberg–Marquardt damping λ on every dof, free root included (GMR: 0.5).
     pub damping: f64,

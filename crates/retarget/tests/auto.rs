@@ -303,10 +303,11 @@ fn every_shared_fbx_onto_the_g1_and_the_t1_in_both_solves() {
             let name = file.file_name().unwrap().to_string_lossy().into_owned();
             let clip = retarget::FbxClip::read(file, None).unwrap();
             for mode in [retarget::SolveMode::default(), retarget::SolveMode::Gmr] {
-                let options = RetargetOptions {
-                    fk: clip.fk_options(&fk::FkOptions::default()),
-                    mode: mode.clone(),
-                    ..RetargetOptions::default()
+                let options = {
+                    let mut o = RetargetOptions::default();
+                    o.fk = clip.fk_options(&fk::FkOptions::default());
+                    o.mode = mode.clone();
+                    o
                 };
                 let checks = run_with(&model, key, &clip.bvh, tuned.as_ref(), &options);
                 let what = format!(

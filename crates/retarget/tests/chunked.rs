@@ -51,7 +51,11 @@ fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
         orientations: full.orientations[..n * nb].to_vec(),
         ..full
     };
-    let options = RetargetOptions { human_height: Some(height), ..base };
+    let options = {
+        let mut o = base;
+        o.human_height = Some(height);
+        o
+    };
     let (serial, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     let chunk = ChunkOptions { frames: 300, lead_in: 60 };
     let (chunked, diag) =
@@ -83,7 +87,11 @@ fn chunks_against_serial(base: RetargetOptions, tolerance: f64) {
 #[test]
 fn chunk_seams_keep_the_root_quaternion_on_one_side_of_the_double_cover() {
     let Some((model, config, human, height)) = g1_walk() else { return };
-    let options = RetargetOptions { human_height: Some(height), ..RetargetOptions::gmr() };
+    let options = {
+        let mut o = RetargetOptions::gmr();
+        o.human_height = Some(height);
+        o
+    };
     let (serial, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     let chunk = ChunkOptions { frames: 600, lead_in: 60 };
     let (chunked, _) = retarget_motion_chunked(&human, &model, &config, &options, chunk).unwrap();

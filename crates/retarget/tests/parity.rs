@@ -95,7 +95,11 @@ fn lafan1_walk_on_g1_matches_gmr() {
             .unwrap();
     assert_same_numbers(&config, &gmr_config);
 
-    let options = RetargetOptions { human_height: Some(1.75), ..RetargetOptions::gmr() };
+    let options = {
+        let mut o = RetargetOptions::gmr();
+        o.human_height = Some(1.75);
+        o
+    };
     let (motion, diag) =
         retarget::internals::retarget_bvh(&bvh, &model, &config, &options).unwrap();
 

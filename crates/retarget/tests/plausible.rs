@@ -62,7 +62,11 @@ fn solve(
     let bvh = bvh::from_path(&path).unwrap();
     let (full, human_report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
     let human = slice(&full, range);
-    let options = RetargetOptions { human_height: Some(human_report.height), ..base };
+    let options = {
+        let mut o = base;
+        o.human_height = Some(human_report.height);
+        o
+    };
     let (motion, _) = retarget_motion(&human, &model, &config, &options).unwrap();
     assert!(motion.contacts.is_some(), "both solves carry the source's contacts");
     Some(report(&motion, &model, &ReportOptions::default()).unwrap())
@@ -296,7 +300,12 @@ fn the_first_frame_is_not_pulled_towards_the_last() {
         let mut plausible = retarget::PlausibleOptions::default();
         plausible.trajectory.iterations = iterations;
         let mode = retarget::SolveMode::Plausible(plausible);
-        let options = RetargetOptions { human_height: Some(height), mode, ..Default::default() };
+        let options = {
+            let mut o = RetargetOptions::default();
+            o.human_height = Some(height);
+            o.mode = mode;
+            o
+        };
         retarget_motion(&human, &model, &config, &options).unwrap().0
     };
     let (solved, first_pass) = (solve(2), solve(0));
@@ -320,7 +329,11 @@ fn a_clip_that_begins_mid_motion_tracks_from_its_first_frame() {
     let Some((model, config, full, height)) = g1_jumps() else { return };
     let nq = model.nq;
     let solve = |from: usize, to: usize| {
-        let options = RetargetOptions { human_height: Some(height), ..RetargetOptions::causal() };
+        let options = {
+            let mut o = RetargetOptions::causal();
+            o.human_height = Some(height);
+            o
+        };
         retarget_motion(&slice(&full, from..to), &model, &config, &options).unwrap().0
     };
     let mut differences: Vec<f64> = (1..=10)
@@ -382,9 +395,10 @@ fn a_limb_stuck_in_another_branch_is_taken_from_the_backward_pass() {
         return;
     };
     let solve = |both_ways| {
-        let mode = retarget::SolveMode::Plausible(retarget::PlausibleOptions {
-            both_ways,
-            ..Default::default()
+        let mode = retarget::SolveMode::Plausible({
+            let mut o = retarget::PlausibleOptions::default();
+            o.both_ways = both_ways;
+            o
         });
         let r = retarget::Retargeter::new("engineai_pm01").unwrap().with_mode(mode);
         let (motion, _) = r.retarget_bvh_file(&path).unwrap();
@@ -420,9 +434,10 @@ fn a_robot_that_cannot_stand_crossed_steps_beside_instead() {
         fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
     let human = slice(&full, 2900..3400);
     let robot = |uncross_stuck| {
-        let mode = retarget::SolveMode::Plausible(retarget::PlausibleOptions {
-            uncross_stuck,
-            ..Default::default()
+        let mode = retarget::SolveMode::Plausible({
+            let mut o = retarget::PlausibleOptions::default();
+            o.uncross_stuck = uncross_stuck;
+            o
         });
         retarget::Retargeter::new("booster_t1_29dof")
             .unwrap()

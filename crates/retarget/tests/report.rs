@@ -122,11 +122,19 @@ fn check_known_slide(model: &mjcf::Model) {
     assert_eq!(rep.floating.frames, 0);
     assert!((rep.floating.cm_max - 0.1).abs() < 1e-9, "{:?}", rep.floating);
     // A higher sliding threshold leaves only the full-speed frames.
-    let strict = ReportOptions { slide_speed: 0.2, ..ReportOptions::default() };
+    let strict = {
+        let mut o = ReportOptions::default();
+        o.slide_speed = 0.2;
+        o
+    };
     let rep = report(&motion, model, &strict).unwrap();
     assert_eq!(rep.feet[0].sliding_frames, 19);
     // Too fast for contact (above contact_speed): the sliding frames stop being contact.
-    let loose = ReportOptions { contact_speed: 0.2, ..ReportOptions::default() };
+    let loose = {
+        let mut o = ReportOptions::default();
+        o.contact_speed = 0.2;
+        o
+    };
     let rep = report(&motion, model, &loose).unwrap();
     assert_eq!(rep.feet[0].contact_frames, FRAMES - 19);
     assert_eq!(rep.feet[0].contact_phases, 2);
@@ -255,7 +263,11 @@ fn velocities_jitter_and_tracking() {
     }
     motion.targets =
         Some(TrackedTargets { body_names: names.map(str::to_owned).to_vec(), pos, quat });
-    let opts = ReportOptions { joint_velocity_limit: Some(1.0), ..ReportOptions::default() };
+    let opts = {
+        let mut o = ReportOptions::default();
+        o.joint_velocity_limit = Some(1.0);
+        o
+    };
     let rep = report(&motion, &model, &opts).unwrap();
     let j = rep.joints.iter().find(|j| j.joint == "left_knee_joint").unwrap();
     assert!((j.vel_max - rate).abs() < 1e-9 && (j.vel_p99 - rate).abs() < 1e-9, "{j:?}");
@@ -281,9 +293,10 @@ fn velocities_jitter_and_tracking() {
 fn unknown_foot_names_are_errors() {
     let Some(model) = g1() else { return };
     let (motion, _) = sliding_motion(&model, 0.0, 0.0);
-    let opts = ReportOptions {
-        feet: Some(["left_foot".to_owned(), "right_ankle_roll_link".to_owned()]),
-        ..ReportOptions::default()
+    let opts = {
+        let mut o = ReportOptions::default();
+        o.feet = Some(["left_foot".to_owned(), "right_ankle_roll_link".to_owned()]);
+        o
     };
     let err = report(&motion, &model, &opts).unwrap_err().to_string();
     assert!(err.contains("left_foot"), "{err}");
@@ -373,7 +386,11 @@ fn toy_motion(model: &mjcf::Model, frames: &[(f64, f64)]) -> RobotMotion {
 }
 
 fn toy_options() -> ReportOptions {
-    ReportOptions { feet: Some(["e".to_owned(), "f".to_owned()]), ..ReportOptions::default() }
+    {
+        let mut o = ReportOptions::default();
+        o.feet = Some(["e".to_owned(), "f".to_owned()]);
+        o
+    }
 }
 
 #[test]
@@ -448,7 +465,11 @@ fn skating_and_stance_follow_the_source_contacts() {
     let k = report(&motion, &model, &ReportOptions::default()).unwrap().skating.unwrap();
     assert_eq!((k.stance_frames, k.skating_frames), (15, 4), "{k:?}");
     // 0.6 m/s is below a 1 m/s threshold.
-    let lax = ReportOptions { skate_speed: 1.0, ..ReportOptions::default() };
+    let lax = {
+        let mut o = ReportOptions::default();
+        o.skate_speed = 1.0;
+        o
+    };
     assert_eq!(report(&motion, &model, &lax).unwrap().skating.unwrap().skating_frames, 0);
 
     // Stance: soles 1 mm up (in the band), then 3 cm up (floating) in the last 10 frames.
@@ -577,7 +598,11 @@ fn the_root_targets_acceleration_is_the_scaled_humans() {
     let quat = vec![nalgebra::UnitQuaternion::identity(); pos.len()];
     motion.targets = Some(TrackedTargets { body_names: names, pos, quat });
     // The config's root (GMR's `robot_root_name`) names the pelvis target.
-    let opts = ReportOptions { root_target: Some("pelvis".to_owned()), ..ReportOptions::default() };
+    let opts = {
+        let mut o = ReportOptions::default();
+        o.root_target = Some("pelvis".to_owned());
+        o
+    };
     let rep = report(&motion, &model, &opts).unwrap();
     let t = rep.root_acceleration.target.expect("the pelvis is a target");
     assert!((t.mean_mps2 - 3.0 * G).abs() < 1e-6 && t.share_over == 1.0, "{t:?}");
@@ -589,8 +614,11 @@ fn the_root_targets_acceleration_is_the_scaled_humans() {
     assert_eq!(first.target_body.as_deref(), Some("left_wrist_yaw_link"));
     assert!((first.target.unwrap().mean_mps2 - 100.0).abs() < 1e-6);
     // A root that is no target: none.
-    let opts =
-        ReportOptions { root_target: Some("torso_link".to_owned()), ..ReportOptions::default() };
+    let opts = {
+        let mut o = ReportOptions::default();
+        o.root_target = Some("torso_link".to_owned());
+        o
+    };
     assert!(report(&motion, &model, &opts).unwrap().root_acceleration.target.is_none());
 }
 

@@ -76,7 +76,11 @@ fn recovers_own_fk_pose() {
         q[0] += 0.3;
         q[1] -= 0.2;
         let targets = poses_of(&model, &q, &bodies);
-        let options = SolverOptions { stop_threshold: -1.0, ..SolverOptions::default() };
+        let options = {
+            let mut o = SolverOptions::default();
+            o.stop_threshold = -1.0;
+            o
+        };
         let mut solver = Solver::new(&model, std::slice::from_ref(&tasks), options).unwrap();
         let mut last = f64::INFINITY;
         for _ in 0..300 {
@@ -129,7 +133,11 @@ fn max_joint_speed_bounds_every_frame() {
     let body = model.body_id("left_wrist_yaw_link").unwrap();
     let targets = poses_of(&model, &q, &[body]);
     let tasks = vec![TaskSpec { body, target: 0, pos_weight: 10.0, rot_weight: 10.0 }];
-    let options = SolverOptions { max_joint_speed: Some(1.0), ..SolverOptions::default() };
+    let options = {
+        let mut o = SolverOptions::default();
+        o.max_joint_speed = Some(1.0);
+        o
+    };
     let mut solver = Solver::new(&model, &[tasks], options).unwrap();
     for _ in 0..5 {
         let before = solver.qpos().to_vec();

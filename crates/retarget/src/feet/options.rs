@@ -11,6 +11,7 @@ pub enum Anchor {
 
 /// Tunables of the foot plan (`plan`).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FootPlanOptions {
     /// Where a planted foot stays during its stance phase.
     pub anchor: Anchor,

@@ -18,6 +18,7 @@ use crate::writers::BodyPoses;
 
 /// Tunables of the dynamics check ([`super::ReportOptions::dynamics`]).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct DynamicsOptions {
     /// A collision geom's bottom point within this height of the ground is a contact (m).
     /// Default 0.01.

@@ -28,6 +28,7 @@ impl Default for SolveMode {
 
 /// Tunables of [`SolveMode::Plausible`].
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct PlausibleOptions {
     /// Whether the robot's feet are planted on the floor during the source's contact phases
     /// (this plans over the whole clip, so it needs the future). The phases themselves are
@@ -157,6 +158,7 @@ impl PlausibleOptions {
 
 /// Options of a [`crate::Retargeter`]'s solve.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct RetargetOptions {
     /// Subject height in metres; `None` uses the FK estimate (GMR assumes 1.75).
     pub human_height: Option<f64>,
