@@ -363,12 +363,7 @@ impl<'m> Solver<'m> {
 
     /// Restart from `qpos` (length `nq`).
     pub fn set_qpos(&mut self, qpos: &[f64]) -> Result<(), Error> {
-        if qpos.len() != self.model.nq || qpos.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "qpos must be {} finite numbers",
-                self.model.nq
-            )));
-        }
+        self.check_qpos(qpos)?;
         self.qpos.copy_from_slice(qpos);
         self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
@@ -731,6 +726,17 @@ impl<'m> Solver<'m> {
     pub fn errors(&self, targets: &[Pose]) -> Result<(Vec<f64>, Vec<f64>), Error> {
         self.check_targets(targets)?;
         Ok(self.tracking_errors(targets))
+    }
+
+    /// `qpos` is a configuration of this model: `nq` finite numbers.
+    fn check_qpos(&self, qpos: &[f64]) -> Result<(), Error> {
+        if qpos.len() != self.model.nq || qpos.iter().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidOption(format!(
+                "qpos must be {} finite numbers",
+                self.model.nq
+            )));
+        }
+        Ok(())
     }
 
     /// `targets` has a pose for every task's and point task's target slot.

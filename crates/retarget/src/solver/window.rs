@@ -35,29 +35,16 @@ impl<'m> Solver<'m> {
     /// The configuration of the frame after this one (length `nq`), or none: the speed
     /// limits of the next steps hold towards it as well as from the frame before.
     pub fn set_next(&mut self, next: Option<&[f64]>) -> Result<(), Error> {
-        match next {
-            Some(q) if q.len() != self.model.nq || q.iter().any(|v| !v.is_finite()) => {
-                Err(Error::InvalidOption(format!("qpos must be {} finite numbers", self.model.nq)))
-            }
-            Some(q) => {
-                self.next = Some(q.to_vec());
-                Ok(())
-            }
-            None => {
-                self.next = None;
-                Ok(())
-            }
+        if let Some(q) = next {
+            self.check_qpos(q)?;
         }
+        self.next = next.map(<[f64]>::to_vec);
+        Ok(())
     }
 
     /// The configuration the speed limits count from (the frame before this one).
     pub fn set_previous(&mut self, previous: &[f64]) -> Result<(), Error> {
-        if previous.len() != self.model.nq || previous.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "qpos must be {} finite numbers",
-                self.model.nq
-            )));
-        }
+        self.check_qpos(previous)?;
         self.previous.copy_from_slice(previous);
         Ok(())
     }
