@@ -152,14 +152,7 @@ impl<'m> Solver<'m> {
             }
         }
         self.set_bounds(dt);
-        let status = if self.constraints.is_empty() || !self.constraints_on {
-            self.mirror_hessian();
-            let status = self.qp.solve();
-            self.dq.copy_from_slice(&self.qp.x);
-            status
-        } else {
-            self.constrained_step()
-        };
+        let status = self.solve_step();
         let optimal = status == QpStatus::Optimal;
         if matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
             self.take_step();
