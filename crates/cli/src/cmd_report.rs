@@ -51,10 +51,18 @@ pub struct ReportArgs {
     /// support in m, the needed force in N and torque in N m).
     #[arg(long, value_name = "OUT.csv")]
     pub dynamics_frames: Option<PathBuf>,
+    /// Measure tracking against the targets stored in another motion of the same clip
+    /// (same frame count and target bodies), e.g. a `--gmr` run's: the default solve's motion
+    /// against GMR's own targets rather than the planted ones it tracked.
+    #[arg(long, value_name = "OTHER.npz")]
+    pub targets_from: Option<PathBuf>,
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
-    let motion = read_motion_npz(&args.motion)?;
+    let mut motion = read_motion_npz(&args.motion)?;
+    if let Some(other) = &args.targets_from {
+        motion.targets = Some(targets_of(other, &motion)?);
+    }
     let (model, robot_arg) = match &args.robot {
         Some(robot) => (shipped::robot_model(robot)?, robot.clone()),
         None => {
@@ -115,4 +123,23 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(ExitCode::SUCCESS),
     }
+}
+
+/// The targets stored in `other`, checked to be of the same clip as `motion`: same frame
+/// count, and targets there.
+fn targets_of(
+    other: &std::path::Path,
+    motion: &retarget::RobotMotion,
+) -> anyhow::Result<retarget::TrackedTargets> {
+    let theirs = read_motion_npz(other)?;
+    let frames = motion.num_frames();
+    anyhow::ensure!(
+        theirs.num_frames() == frames,
+        "{}: {} frames, the motion has {frames}: --targets-from needs a motion of the same clip",
+        other.display(),
+        theirs.num_frames()
+    );
+    theirs.targets.with_context(|| {
+        format!("{}: no targets stored (target_pos / target_quat)", other.display())
+    })
 }
