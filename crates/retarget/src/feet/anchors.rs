@@ -153,10 +153,15 @@ pub(super) fn turn_of(yaws: &[f64], reference: f64) -> f64 {
     }
 }
 
-/// The flat foot's horizontal position (`xy` at `yaw0`) turned to `yaw` about its toe point
-/// ([`RobotFoot::toe_point`], where the report measures skating).
-pub(super) fn pivot(foot: &RobotFoot, xy: Vector3<f64>, yaw0: f64, yaw: f64) -> Vector3<f64> {
-    let c = foot.toe_point();
+/// The flat foot's horizontal position (`xy` at `yaw0`) turned to `yaw` about `c` (a point of
+/// the foot, foot frame: the ball a pivot turns on, [`RobotFoot::ball_point`]).
+pub(super) fn pivot(
+    foot: &RobotFoot,
+    c: Vector3<f64>,
+    xy: Vector3<f64>,
+    yaw0: f64,
+    yaw: f64,
+) -> Vector3<f64> {
     let d = foot.flat(yaw0) * c - foot.flat(yaw) * c;
     Vector3::new(xy.x + d.x, xy.y + d.y, xy.z)
 }
@@ -286,17 +291,19 @@ mod tests {
     }
 
     #[test]
-    fn a_foot_that_turns_far_in_stance_pivots_about_its_toe() {
+    fn a_foot_that_turns_far_in_stance_pivots_about_its_ball() {
         let yaw = |p: &Pose| quat(p).euler_angles().2;
-        // 90°: the planted foot turns with the source's, its toe still.
+        // 90°: the planted (left) foot turns with the source's about the ball of its foot,
+        // the inner toe corner, which stays still.
         let (targets, foot) = turning_stance(std::f64::consts::FRAC_PI_2);
-        let toe = |p: &Pose| p.pos + quat(p) * foot.toe_point();
-        let first = toe(&targets[0]);
+        assert_eq!(foot.ball_point(0), Vector3::new(0.1, -0.05, -0.02));
+        let ball = |p: &Pose| p.pos + quat(p) * foot.ball_point(0);
+        let first = ball(&targets[0]);
         for (t, p) in targets.iter().enumerate() {
             let expected = std::f64::consts::FRAC_PI_2 * t as f64 / 29.0;
             assert!((yaw(p) - expected).abs() < 1e-9, "frame {t}: yaw {}", yaw(p));
-            let moved = (toe(p) - first).xy().norm();
-            assert!(moved < 1e-9, "frame {t}: the toe moved {moved} m");
+            let moved = (ball(p) - first).xy().norm();
+            assert!(moved < 1e-9, "frame {t}: the ball moved {moved} m");
         }
         // 20°, under `pivot_turn`: one yaw for the whole phase (the mean), the foot still.
         let (targets, _) = turning_stance(20f64.to_radians());
@@ -318,10 +325,18 @@ mod tests {
         for (t, p) in targets.iter().enumerate() {
             let up = heel_over_toe(p, &foot);
             assert!((up - lift).abs() < 1e-9, "frame {t}: heel {up} m above the toe");
+            // It stands on the ball alone (the inner toe corner), its outer toe corner up.
             let low = targets[t].pos.z + (quat(p) * foot.corners[2]).z;
             assert!(
                 (low - FootPlanOptions::default().clearance).abs() < 1e-9,
-                "frame {t}: toe at {low}"
+                "frame {t}: ball at {low}"
+            );
+            // (CONTACT_PATCH across the sole, pitched heel up: cos 5.7° of it.)
+            let outer = targets[t].pos.z + (quat(p) * foot.corners[3]).z;
+            assert!(
+                (outer - low - crate::feet::soles::CONTACT_PATCH).abs() < 1e-4,
+                "frame {t}: outer toe {} m above the ball",
+                outer - low
             );
         }
         // A slow pivot, 46° in 1 s (0.16 m/s, under `pivot_heel_speed`), lifts it part of the

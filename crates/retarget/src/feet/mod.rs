@@ -19,14 +19,18 @@
 //!    (heel strike, toe off), faded in and out over [`FootPlanOptions::roll_s`].
 //!    A phase over which the source foot turns through more than
 //!    [`FootPlanOptions::pivot_turn`] (45°) is a **pivot**: the planted foot turns with the
-//!    source's yaw about its toe point (which stays on the anchor), as a foot turning on its
-//!    ball does, instead of holding the mean yaw and twisting the leg by half the turn.
-//!    Where it turns fast it stands on its ball: it rolls no more with the human's foot and
-//!    its heel rises up to [`FootPlanOptions::pivot_heel_lift`] (2 cm) above its toe, fully
-//!    where turning flat would slide the heel at [`FootPlanOptions::pivot_heel_speed`]
-//!    (0.2 m/s). (95 % of the frames the report counted as skating on the LAFAN1 jumps were
-//!    flat soles turning at up to 450°/s; at 1.75 m, floor skating on the G1's jumps went
-//!    from 1.40 to 0.31 %, on the T1's from 2.03 to 1.01 %.)
+//!    source's yaw about the ball of its foot ([`RobotFoot::ball_point`], the inner toe
+//!    corner, which stays on the anchor), as a foot turning on its ball does, instead of
+//!    holding the mean yaw and twisting the leg by half the turn. Where it turns fast it
+//!    stands on its ball alone: it rolls no more with the human's foot, its heel rises up to
+//!    [`FootPlanOptions::pivot_heel_lift`] (2 cm) above its toe and its outer toe corner
+//!    [`CONTACT_PATCH`](soles::CONTACT_PATCH) above the ball, fully where turning flat would
+//!    slide the heel at [`FootPlanOptions::pivot_heel_speed`] (0.2 m/s). (95 % of the frames the report counted
+//!    as skating on the LAFAN1 jumps were flat soles turning at up to 450°/s; at 1.75 m,
+//!    floor skating on the G1's jumps went from 1.40 to 0.31 %, on the T1's from 2.03 to
+//!    1.01 % with the heel up; standing on the one corner took the T1's mid-stance turns out
+//!    of it, where both toe corners had slid at the turn's rate times half the sole's width.)
+//!    A foot whose ankle cannot roll (the H1's) turns about the middle of its toes instead.
 //!    Overlapping stance phases of the two feet are kept apart; where the left foot stands
 //!    to the right of the right one, they are a [`Crossing`], which the solve can ask to be
 //!    planned again side by side ([`plan_uncrossing`]) when the robot cannot stand in it.
@@ -35,7 +39,8 @@
 //!    floor), risen to it over [`FootPlanOptions::lift_s`] after lift-off and left over as
 //!    long before touch-down; in those frames the sole points that stood on the floor at
 //!    lift-off (stand on it at touch-down) are held where they were (will be), seen from
-//!    above: a foot leaves the floor by lifting its last contact, not by sliding it.
+//!    above, as firmly in all as a planted sole's: a foot leaves the floor by lifting its
+//!    last contact, not by sliding it.
 //!
 //! The solve ([`crate::solve`]) sees every frame at once: there is no blending of targets
 //! into and out of stance; the accelerations cost it makes the transitions.
@@ -155,7 +160,7 @@ pub fn plan_uncrossing(
         let Some(foot) = foot else { continue };
         let roll = roll_shares(&planted_mask[1 - side], roll_frames);
         let planted =
-            plant(foot, &anchors[side], &free[side], &free_yaw[side], &roll, fps, options);
+            plant(foot, side, &anchors[side], &free[side], &free_yaw[side], &roll, fps, options);
         plan.set_stance(foot, side, &planted, options.stance_weight, targets, slots);
         let held: Vec<bool> = planted.iter().map(Option::is_some).collect();
         let swings = swing(foot, &held, &free[side], targets, slots, fps, options);

@@ -43,7 +43,9 @@ pub struct FootPlanOptions {
     pub lift_s: f64,
     /// A stance phase over which the source foot's yaw turns through more than this (rad,
     /// largest minus smallest) is a **pivot**: the planted foot turns with the source's, about
-    /// its toe point (`RobotFoot::toe_point`), which stays where the anchor puts it. Holding the mean yaw there
+    /// the ball of its foot (`RobotFoot::ball_point`: the inner toe corner; the middle of the
+    /// toes, `RobotFoot::toe_point`, where the ankle cannot roll), which stays where the anchor
+    /// puts it. Holding the mean yaw there
     /// (a dancer or a jumper turning on one foot) twisted the leg by half the turn: 45° on
     /// the LAFAN1 jumps, where the PM01's hip then went past its yaw range's middle and
     /// stayed there for the 2,000 frames that followed. A turning sole sweeps the floor, so

@@ -36,7 +36,37 @@ pub struct RobotFoot {
     pub(super) shin: Option<(usize, UnitQuaternion<f64>)>,
     /// The sole's collision geoms (none for a sole of inertia).
     pub geoms: Vec<usize>,
+    /// Whether the ankle can roll the foot (a hinge between the shin and the foot turns
+    /// about the foot's forward direction): a foot that can stands on the ball of its foot
+    /// alone when it pivots; one that cannot (the H1's pitch-only ankle) stands on its toes.
+    pub(super) rolls: bool,
 }
+
+/// Whether a hinge of the ankle, the joints from the foot `body` up to its `shin` (the
+/// nearest tracked ancestor; without one, the first [`ANKLE_HINGES`] hinges above the foot),
+/// turns about the foot's forward direction at `qpos0` (world +x, as [`RobotFoot`]'s
+/// `forward`; within 45°).
+fn ankle_rolls(model: &Model, data: &Data, body: usize, shin: Option<usize>) -> bool {
+    let forward = Vector3::x();
+    let mut hinges = 0;
+    let mut b = body;
+    while b != 0 && Some(b) != shin && hinges < ANKLE_HINGES {
+        let first = model.bodies[b].jnt_adr;
+        for j in first..first + model.bodies[b].jnt_num {
+            if model.joints[j].kind == mjcf::JointType::Hinge {
+                hinges += 1;
+                if data.xaxis[j].dot(&forward).abs() > std::f64::consts::FRAC_1_SQRT_2 {
+                    return true;
+                }
+            }
+        }
+        b = model.bodies[b].parent;
+    }
+    false
+}
+
+/// Hinges of an ankle, where no shin bounds it ([`ankle_rolls`]): pitch and roll.
+const ANKLE_HINGES: usize = 2;
 
 /// Sole bottom points higher than the lowest by this much (m) are not held vertically;
 /// lower ones are held the more, the lower they are.
@@ -98,6 +128,7 @@ impl RobotFoot {
             .iter()
             .flat_map(|(kind, size, rel)| bottom_points(*kind, size, rel, &body_pose.rotation))
             .collect();
+        let rolls = ankle_rolls(model, &data, body, shin.map(|s| s.0));
         let shin = shin.map(|(shin_body, shin_slot)| {
             let shin_rest = UnitQuaternion::from_matrix(&data.xmat[shin_body]);
             (shin_slot, shin_rest.inverse() * body_pose.rotation)
@@ -111,6 +142,7 @@ impl RobotFoot {
             corners,
             shin,
             geoms,
+            rolls,
         })
     }
 
@@ -138,6 +170,27 @@ impl RobotFoot {
             [a, b, ..] => (a + b) / 2.0,
             _ => self.sole_low_point(&self.rest),
         }
+    }
+
+    /// The ball of the foot in the foot frame: of the sole's two foremost bottom points, the
+    /// one on the inner side (towards the other foot: the big toe's), where a foot turning on
+    /// its toes stands; else [`RobotFoot::toe_point`]. `side`: 0 the left foot, 1 the right.
+    #[must_use]
+    pub fn ball_point(&self, side: usize) -> Vector3<f64> {
+        let mut corners = self.corners.clone();
+        corners.sort_by(|a, b| self.forward.dot(b).total_cmp(&self.forward.dot(a)));
+        let left = self.left();
+        match corners.as_slice() {
+            // The left foot's inner side is its right (−left), the right foot's its left.
+            [a, b, ..] if (left.dot(a) < left.dot(b)) == (side == 0) => *a,
+            [_, b, ..] => *b,
+            _ => self.toe_point(),
+        }
+    }
+
+    /// The foot's left direction in its own frame (world up × forward, standing flat).
+    pub(super) fn left(&self) -> Vector3<f64> {
+        (self.rest.inverse() * Vector3::z()).cross(&self.forward)
     }
 
     /// The sole's lowest point for a body orientation `rot`, in the foot body's frame.
@@ -288,6 +341,7 @@ pub(super) mod fixtures {
             corners,
             shin: None,
             geoms: Vec::new(),
+            rolls: true,
         }
     }
 }

@@ -16,7 +16,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use super::anchors::{anchored, pivot, turn_of, Planted};
 use super::math::{quat, smoothstep, wrap};
 use super::options::FootPlanOptions;
-use super::soles::RobotFoot;
+use super::soles::{RobotFoot, CONTACT_PATCH};
 use crate::lie::Pose;
 
 /// Rescalings of a planted foot's tilt in [`RobotFoot::within_band`]: the spread of the sole's
@@ -66,6 +66,36 @@ impl RobotFoot {
         }
     }
 
+    /// The sole's width (m): the spread of its bottom points across its forward direction.
+    fn width(&self) -> f64 {
+        let left = self.left();
+        let across = self.corners.iter().map(|c| left.dot(c));
+        let (lo, hi) =
+            across.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        if lo < hi {
+            hi - lo
+        } else {
+            0.0
+        }
+    }
+
+    /// `rot` rolled about the foot's own forward axis so that the sole's outer edge (the left
+    /// foot's left, `side` 0; the right foot's right) rises `lift` (m) above its inner edge.
+    fn outside_up(&self, rot: &UnitQuaternion<f64>, lift: f64, side: usize) -> UnitQuaternion<f64> {
+        let width = self.width();
+        if lift <= 0.0 || width <= lift {
+            return *rot;
+        }
+        // A positive turn about forward raises the left edge.
+        let sign = if side == 0 { 1.0 } else { -1.0 };
+        match nalgebra::Unit::try_new(rot * self.forward, 1e-9) {
+            Some(axis) => {
+                UnitQuaternion::from_axis_angle(&axis, sign * (lift / width).asin()) * rot
+            }
+            None => *rot,
+        }
+    }
+
     /// `rot` pitched toe-down about the foot's own left axis, so that the sole's back end
     /// rises `lift` (m) above its front.
     fn heel_up(&self, rot: &UnitQuaternion<f64>, lift: f64) -> UnitQuaternion<f64> {
@@ -99,14 +129,19 @@ pub(super) fn roll_shares(other: &[bool], roll_frames: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Per frame, the planted pose of `foot` in its stance `phases` (`None` out of stance): the
-/// flat foot at the phase's anchor (a pivot's turned with the source's yaw, `free_yaw`, about
-/// its toe), tilted as the `free` target within [`FootPlanOptions::sole_band`], rolled by
-/// `roll` towards the free target's tilt, resting at [`FootPlanOptions::clearance`]. A
-/// pivot turns on the ball: as fast as it turns (at `fps` frames a second), it rolls no
-/// more with the human's foot and its heel rises ([`FootPlanOptions::pivot_heel_lift`]).
+/// Per frame, the planted pose of `foot` (`side` 0 left, 1 right) in its stance `phases`
+/// (`None` out of stance): the flat foot at the phase's anchor (a pivot's turned with the
+/// source's yaw, `free_yaw`, about the ball of the foot, [`RobotFoot::ball_point`]), tilted
+/// as the `free` target within [`FootPlanOptions::sole_band`], rolled by `roll` towards the
+/// free target's tilt, resting at [`FootPlanOptions::clearance`]. A pivot turns on the ball:
+/// as fast as it turns (at `fps` frames a second), it rolls no more with the human's foot,
+/// its heel rises ([`FootPlanOptions::pivot_heel_lift`]) and its outer toe rises
+/// [`CONTACT_PATCH`], so that the ball is the one point it stands on (a rigid sole turning on
+/// two points slides one of them).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn plant(
     foot: &RobotFoot,
+    side: usize,
     phases: &[Planted],
     free: &[Pose],
     free_yaw: &[f64],
@@ -115,12 +150,18 @@ pub(super) fn plant(
     options: &FootPlanOptions,
 ) -> Vec<Option<Pose>> {
     let mut planted = vec![None; free.len()];
+    // A foot whose ankle cannot roll stands on its toes, two points: it turns about their
+    // middle, which slides them least.
+    let ball = if foot.rolls { foot.ball_point(side) } else { foot.toe_point() };
     for (r, xy, yaw) in phases {
         let (xy, yaw) = (*xy, *yaw);
         let pivots = turn_of(&free_yaw[r.clone()], yaw) > options.pivot_turn;
         for t in r.clone() {
-            let (xy, yaw) =
-                if pivots { (pivot(foot, xy, yaw, free_yaw[t]), free_yaw[t]) } else { (xy, yaw) };
+            let (xy, yaw) = if pivots {
+                (pivot(foot, ball, xy, yaw, free_yaw[t]), free_yaw[t])
+            } else {
+                (xy, yaw)
+            };
             let tilt = quat(&free[t]);
             let turning = if pivots {
                 let rate = turn_rate(free_yaw, r.clone(), t, fps);
@@ -131,6 +172,7 @@ pub(super) fn plant(
             let q =
                 foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t] * (1.0 - turning));
             let q = foot.heel_up(&q, turning * options.pivot_heel_lift);
+            let q = if foot.rolls { foot.outside_up(&q, turning * CONTACT_PATCH, side) } else { q };
             let rolled = Pose { quat: [q.w, q.i, q.j, q.k], pos: free[t].pos };
             planted[t] = Some(planted_pose(foot, &rolled, xy, yaw, options.clearance));
         }

@@ -50,12 +50,7 @@ pub(super) fn swing(
             let mut out = Swing::default();
             if frames_off as f64 <= lift_frames {
                 let edge_pose = targets[edge * slots + foot.slot];
-                out.held = foot
-                    .contact_points(&edge_pose, 1.0)
-                    .into_iter()
-                    .filter(|p| p.vertical > 0.0)
-                    .map(|p| SolePoint { vertical: 0.0, ..p })
-                    .collect();
+                out.held = held_points(foot, &edge_pose);
             }
             // (At 30 fps and 1/30 s, one frame is all the way up.)
             let rise = smoothstep((frames_off as f64 / (options.lift_s * fps) + ROUNDING).min(1.0));
@@ -73,6 +68,20 @@ pub(super) fn swing(
             Some(out)
         })
         .collect()
+}
+
+/// The sole points a rising (or landing) foot holds where they stand at `edge` (its last or
+/// first planted pose): those on the floor there ([`RobotFoot::contact_points`]), held
+/// horizontally only, and as firmly in all as a planted sole's points (their shares' root sum
+/// of squares 1). Kept at their shares of the whole sole, the two toe points of a foot that
+/// lifts on its toes held half as firmly as a planted foot, and a foot whose human's turned
+/// as it left the floor (the LAFAN1 jumps: up to 40° in the frame) slid them: 34 of the T1
+/// jumps' 54 frames that skated on the floor were the frame before a lift-off or a touch-down.
+fn held_points(foot: &RobotFoot, edge: &Pose) -> Vec<SolePoint> {
+    let on_floor: Vec<SolePoint> =
+        foot.contact_points(edge, 1.0).into_iter().filter(|p| p.vertical > 0.0).collect();
+    let share = 1.0 / (on_floor.len().max(1) as f64).sqrt();
+    on_floor.into_iter().map(|p| SolePoint { vertical: 0.0, horizontal: share, ..p }).collect()
 }
 
 /// Per frame out of stance, the nearer of the planted frames around it (the last before, the
@@ -138,6 +147,22 @@ mod tests {
     }
 
     #[test]
+    fn a_foot_rising_from_its_toes_holds_them_as_firmly_as_a_planted_sole() {
+        let mut foot = box_foot();
+        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+        // Heel up 10°: the two toe corners on the floor, the heel 3.5 cm above them.
+        let q = nalgebra::UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.17);
+        let edge = Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.0, 0.0, 0.05) };
+        let held = held_points(&foot, &edge);
+        assert_eq!(held.len(), 2);
+        for p in &held {
+            assert!(p.point.x > 0.0, "a toe point: {p:?}");
+            assert!((p.horizontal - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12, "{p:?}");
+            assert_eq!(p.vertical, 0.0);
+        }
+    }
+
+    #[test]
     fn swing_feet_clear_the_floor_and_lift_before_they_move() {
         let options = FootPlanOptions::default();
         for fps in [30.0, 120.0] {
@@ -165,6 +190,9 @@ mod tests {
                     let anchor = if t - lift < touch - lead - t { lift - 1 } else { touch - lead };
                     let held = &plan.contact[t][0];
                     assert!(!held.is_empty(), "fps {fps} frame {t}");
+                    // As firmly in all as a planted sole's points.
+                    let rss = held.iter().map(|p| p.horizontal * p.horizontal).sum::<f64>();
+                    assert!((rss - 1.0).abs() < 1e-9, "fps {fps} frame {t}: {rss}");
                     for p in held {
                         let at_edge = targets[anchor].pos + quat(&targets[anchor]) * p.point;
                         assert!(p.vertical == 0.0 && p.horizontal > 0.0);
