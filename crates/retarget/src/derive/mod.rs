@@ -89,6 +89,8 @@ mod shoulder;
 mod weights;
 mod write;
 
+use std::borrow::Cow;
+
 use fk::{Part, Role};
 use mjcf::{Data, Model};
 
@@ -98,8 +100,8 @@ pub use self::joint_frames::{JointFrames, FRAMES_AGREE, LAFAN1_FRAMES};
 pub use self::weights::WEIGHTS;
 
 use self::fit::fitted_offset;
-use self::robot::robot_side;
-use self::shoulder::matched;
+use self::robot::{robot_side, RobotSide};
+use self::shoulder::arm_turns;
 use self::weights::{shoulder_hinges, weights, weights_of};
 use self::write::{entry, file_of, written, Row};
 use crate::config::{ConfigFile, IkConfig, MatchEntry, Ordered};
@@ -184,6 +186,22 @@ fn derived_file(
         rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale, weights });
     }
     Ok(file_of(&rows, human.height))
+}
+
+/// `human` as `robot` is matched with: [`HumanBody::for_robot`], then the arms of a robot
+/// whose shoulders cannot turn the upper arm about its bone turned to what they can do
+/// ([`arm_turns`]).
+fn matched<'a>(human: &'a HumanBody, robot: &RobotSide) -> Cow<'a, HumanBody> {
+    let human = human.for_robot(robot.arms_sideways);
+    let turns = arm_turns(&human, &robot.shoulders, &robot.frames);
+    if turns.is_empty() {
+        return human;
+    }
+    let mut out = human.into_owned();
+    for (role, turn) in turns {
+        out.turn(role, turn);
+    }
+    Cow::Owned(out)
 }
 
 /// A role-named config ([`derive()`] against [`HumanBody::canonical`]) bound to `human` (see

@@ -1,6 +1,6 @@
 //! Shoulders that cannot turn the upper arm about its bone ([`Shoulder`]: one or two hinges,
 //! as servo humanoids have), and the human arm frames turned to what such an arm can do
-//! ([`matched`]).
+//! ([`arm_turns`]).
 //!
 //! A shoulder of two hinges points the upper arm anywhere, but the turn of the arm about its
 //! bone then follows from the direction: the robot has no humeral rotation. The human's arm
@@ -23,16 +23,14 @@
 //! 10° off the human's, the left 5°; the OP3's 14° and 11°; hands L↔L 0.82 and 0.80). A
 //! robot with a three-hinge (or ball) shoulder is not touched.
 
-use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
 use fk::{Part, Role, Side};
 use mjcf::{Data, JointType, Model};
-use nalgebra::{Matrix2, Matrix3x2, Unit, UnitQuaternion, Vector3};
+use nalgebra::{Matrix2, Matrix3x2, Quaternion, Unit, UnitQuaternion, Vector3, Vector4};
 
 use super::human::HumanBody;
-use super::robot::RobotSide;
 use crate::robot_roles::RobotRoles;
 
 /// Starts per hinge of the search for the shoulder angles (spread over the range).
@@ -150,16 +148,17 @@ impl Shoulder {
 }
 
 /// The turn about the bone (rad, about the frame's z) from the robot's upper arm frame,
-/// pointed as the human's by its shoulder, to the human's: `frames` are one posture's human
-/// canonical frames; `None` when the shoulder cannot point the arm there ([`POINTED`]).
+/// pointed as the human's by its shoulder, to the human's: `robot` are the robot's canonical
+/// frames at `qpos0`, `human` one posture's; `None` when the shoulder cannot point the arm
+/// there ([`POINTED`]).
 fn turn_left(
     shoulder: &Shoulder,
-    robot: &RobotSide,
-    frames: &BTreeMap<Role, UnitQuaternion<f64>>,
+    robot: &BTreeMap<Role, UnitQuaternion<f64>>,
+    human: &BTreeMap<Role, UnitQuaternion<f64>>,
     arm: Role,
 ) -> Option<f64> {
-    let (human_top, human_arm) = (frames.get(&shoulder.top)?, frames.get(&arm)?);
-    let (robot_top, robot_arm) = (robot.frames.get(&shoulder.top)?, robot.frames.get(&arm)?);
+    let (human_top, human_arm) = (human.get(&shoulder.top)?, human.get(&arm)?);
+    let (robot_top, robot_arm) = (robot.get(&shoulder.top)?, robot.get(&arm)?);
     // The robot's trunk as the human's: world at qpos0 → the copy.
     let copy = human_top * robot_top.inverse();
     let from = robot_arm * Vector3::z();
@@ -179,15 +178,20 @@ fn turn_left(
         .min_by(|a, b| a.abs().total_cmp(&b.abs()))
 }
 
-/// Per arm role (upper arm, forearm, hand) of a robot arm whose shoulder cannot turn it about
-/// its bone, the turn to right-multiply the human's frames of that role with (see the module
-/// docs): the inverse of the mean over the postures of the turn left, seen from the role's frame.
-fn arm_turns(human: &HumanBody, robot: &RobotSide) -> BTreeMap<Role, UnitQuaternion<f64>> {
+/// Per arm role (upper arm, forearm, hand) of the arms with these `shoulders`, the turn to
+/// right-multiply the human's frames of that role with (see the module docs): the inverse
+/// of the mean over `human`'s postures of the turn left, seen from the role's frame.
+/// `robot` are the robot's canonical frames at `qpos0`.
+pub(super) fn arm_turns(
+    human: &HumanBody,
+    shoulders: &BTreeMap<Side, Shoulder>,
+    robot: &BTreeMap<Role, UnitQuaternion<f64>>,
+) -> BTreeMap<Role, UnitQuaternion<f64>> {
     let mut out = BTreeMap::new();
-    for (side, shoulder) in &robot.shoulders {
+    for (side, shoulder) in shoulders {
         let arm = Role::of(Part::UpperArm, *side);
         let roles = [Part::UpperArm, Part::Forearm, Part::Hand].map(|p| Role::of(p, *side));
-        let mut sums: BTreeMap<Role, nalgebra::Vector4<f64>> = BTreeMap::new();
+        let mut sums: BTreeMap<Role, Vector4<f64>> = BTreeMap::new();
         for posture in &human.postures {
             let Some(psi) = turn_left(shoulder, robot, &posture.frames, arm) else { continue };
             let Some(upper) = posture.frames.get(&arm) else { continue };
@@ -196,15 +200,12 @@ fn arm_turns(human: &HumanBody, robot: &RobotSide) -> BTreeMap<Role, UnitQuatern
                 let Some(frame) = posture.frames.get(&role) else { continue };
                 // The human's frame of this role seen from its upper arm's.
                 let carried = upper.inverse() * frame;
-                let left = carried.inverse() * twist * carried;
-                let c = left.into_inner().coords;
-                let sum = sums.entry(role).or_insert_with(nalgebra::Vector4::zeros);
-                *sum += if c.w < 0.0 { -c } else { c };
+                let c = (carried.inverse() * twist * carried).into_inner().coords;
+                *sums.entry(role).or_insert_with(Vector4::zeros) += if c.w < 0.0 { -c } else { c };
             }
         }
         for (role, sum) in sums {
-            let mean = nalgebra::Quaternion::from(sum);
-            if let Some(mean) = UnitQuaternion::try_new(mean, 1e-9) {
+            if let Some(mean) = UnitQuaternion::try_new(Quaternion::from(sum), 1e-9) {
                 out.insert(role, mean.inverse());
             }
         }
@@ -212,32 +213,22 @@ fn arm_turns(human: &HumanBody, robot: &RobotSide) -> BTreeMap<Role, UnitQuatern
     out
 }
 
-/// `human` as `robot` is matched with: [`HumanBody::for_robot`], then the arms of a robot
-/// whose shoulders cannot turn the upper arm about its bone turned to what they can do (see
-/// the module docs).
-pub(super) fn matched<'a>(human: &'a HumanBody, robot: &RobotSide) -> Cow<'a, HumanBody> {
-    let human = human.for_robot(robot.arms_sideways);
-    let turns = arm_turns(&human, robot);
-    if turns.is_empty() {
-        return human;
-    }
-    let mut out = human.into_owned();
-    for (role, turn) in turns {
-        out.turn(role, turn);
-    }
-    Cow::Owned(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::derive::robot::robot_side;
 
-    fn side_of(path: &str) -> RobotSide {
+    /// The shoulders of a robot file and its canonical frames at `qpos0`.
+    fn shoulders_of(path: &str) -> (BTreeMap<Side, Shoulder>, BTreeMap<Role, UnitQuaternion<f64>>) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path);
         let model = Model::from_path(&path).unwrap();
         let roles = RobotRoles::recognise(&model).unwrap();
-        robot_side(&model, &roles)
+        let mut data = Data::new(&model);
+        model.kinematics(&model.qpos0, &mut data);
+        let shoulders = [Side::Left, Side::Right]
+            .into_iter()
+            .filter_map(|side| Some((side, shoulder(&model, &data, &roles, side)?)))
+            .collect();
+        (shoulders, roles.canonical_frames())
     }
 
     /// The servo robot's shoulders (pitch, then roll) are found, the G1's (three hinges) not.
@@ -246,10 +237,11 @@ mod tests {
     /// mean, 50°, the hanging left arm's not at all.
     #[test]
     fn the_turn_a_two_hinge_shoulder_cannot_make_is_taken_out_of_the_arm() {
-        assert!(side_of("robots/unitree_g1/unitree_g1.xml").shoulders.is_empty());
-        let robot = side_of("tests/data/robots/synthetic/kid_servo.xml");
-        assert_eq!(robot.shoulders.len(), 2);
-        assert!(robot.shoulders.values().all(|s| s.hinges.len() == 2 && s.top == Role::Pelvis));
+        assert!(shoulders_of("robots/unitree_g1/unitree_g1.xml").0.is_empty());
+        // Its arms end at the forearm: its canonical arm frames are the ones derive uses.
+        let (shoulders, frames) = shoulders_of("tests/data/robots/synthetic/kid_servo.xml");
+        assert_eq!(shoulders.len(), 2);
+        assert!(shoulders.values().all(|s| s.hinges.len() == 2 && s.top == Role::Pelvis));
         let mut human = HumanBody::canonical();
         let standing = human.postures[0].clone();
         human.postures = [40f64, 60.0]
@@ -263,7 +255,7 @@ mod tests {
                 posture
             })
             .collect();
-        let turns = arm_turns(&human, &robot);
+        let turns = arm_turns(&human, &shoulders, &frames);
         let back = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -50f64.to_radians());
         for part in [Part::UpperArm, Part::Forearm, Part::Hand] {
             let (left, right) =
@@ -271,11 +263,13 @@ mod tests {
             assert!(left.angle() < 1e-6, "{part:?}: {left:?}");
             assert!(right.angle_to(&back) < 1e-6, "{part:?}: {right:?}");
         }
-        let matched = matched(&human, &robot);
+        for (role, turn) in turns {
+            human.turn(role, turn);
+        }
         let arm = Role::RightUpperArm;
-        assert!(matched.frame_offsets[&arm].angle_to(&back) < 1e-6);
+        assert!(human.frame_offsets[&arm].angle_to(&back) < 1e-6);
         // Each posture is left 10° from the canonical frame, one either way.
-        for p in &matched.postures {
+        for p in &human.postures {
             assert!((p.frames[&arm].angle() - 10f64.to_radians()).abs() < 1e-6);
         }
     }
