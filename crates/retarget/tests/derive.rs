@@ -78,35 +78,18 @@ fn derived_configs_read_back_from_their_text_unchanged() {
 }
 
 /// A role-named config (`retarget robot init` without `--bvh`) bound to a skeleton is the
-/// config derived for that skeleton directly, on every robot with a GMR config.
+/// config derived for that skeleton directly, on every robot with a GMR config and on the
+/// servo robots whose shoulders cannot turn the arm about its bone (their arm frames turned
+/// for the canonical human and for the skeleton, `derive::shoulder`).
 #[test]
 fn binding_a_role_named_config_equals_deriving_for_the_skeleton() {
     let Some(bvh) = lafan_walk() else { return };
     let human = derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
     for key in ["unitree_g1", "booster_t1_29dof", "fourier_n1", "engineai_pm01", "stanford_toddy"] {
-        let (model, _) = shipped(key);
-        let roles = RobotRoles::recognise(&model).unwrap();
-        let canonical = derive::derive(&model, &roles, &HumanBody::canonical(), "c").unwrap();
-        assert!(derive::is_role_named(&canonical), "{key}");
-        let written = IkConfig::from_json_str(canonical.json(), "written").unwrap();
-        let bound = derive::bind(&written, &human, &model, &roles).unwrap();
-        let direct = derive::derive(&model, &roles, &human, "d").unwrap();
-        assert!(!derive::is_role_named(&direct), "{key}");
-        assert!((bound.human_height_assumption - direct.human_height_assumption).abs() < 1e-6);
-        assert_eq!(bound.human_scale_table.len(), direct.human_scale_table.len());
-        for ((a, s), (b, t)) in bound.human_scale_table.iter().zip(&direct.human_scale_table) {
-            assert_eq!(a, b, "{key}");
-            assert!((s - t).abs() < 1e-6, "{key} {a}: {s} vs {t}");
-        }
-        for (e, f) in bound.ik_match_table2.iter().zip(&direct.ik_match_table2) {
-            assert_eq!((&e.robot_body, &e.human_body), (&f.robot_body, &f.human_body));
-            assert_eq!((e.pos_weight, e.rot_weight), (f.pos_weight, f.rot_weight));
-            assert!(e.rot_offset.angle_to(&f.rot_offset) < 1e-6, "{key} {}", e.robot_body);
-            assert!((e.pos_offset - f.pos_offset).norm() < 1e-6, "{key} {}", e.robot_body);
-        }
+        let (model, tuned) = shipped(key);
+        let direct = assert_bound_is_direct(key, &model, &human);
         // On LAFAN1 the derived offsets are near GMR's tuned ones (its 90° guesses): the
         // trunk and legs within 30°.
-        let (_, tuned) = shipped(key);
         for e in direct.ik_match_table1.iter().filter(|e| {
             ["Hips", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg"]
                 .contains(&e.human_body.as_str())
@@ -117,6 +100,36 @@ fn binding_a_role_named_config_equals_deriving_for_the_skeleton() {
             }
         }
     }
+    for servo in ["synthetic/kid_servo.xml", "robotis_op3_urdf/robotis_op3.urdf"] {
+        let path = root().join("tests/data/robots").join(servo);
+        let model = retarget::shipped::load_robot(&path.to_string_lossy()).unwrap();
+        assert_bound_is_direct(servo, &model, &human);
+    }
+}
+
+/// Binds `model`'s role-named config to `human`, asserts it is the config derived for `human`
+/// directly, and returns that.
+fn assert_bound_is_direct(key: &str, model: &mjcf::Model, human: &HumanBody) -> IkConfig {
+    let roles = RobotRoles::recognise(model).unwrap();
+    let canonical = derive::derive(model, &roles, &HumanBody::canonical(), "c").unwrap();
+    assert!(derive::is_role_named(&canonical), "{key}");
+    let written = IkConfig::from_json_str(canonical.json(), "written").unwrap();
+    let bound = derive::bind(&written, human, model, &roles).unwrap();
+    let direct = derive::derive(model, &roles, human, "d").unwrap();
+    assert!(!derive::is_role_named(&direct), "{key}");
+    assert!((bound.human_height_assumption - direct.human_height_assumption).abs() < 1e-6);
+    assert_eq!(bound.human_scale_table.len(), direct.human_scale_table.len());
+    for ((a, s), (b, t)) in bound.human_scale_table.iter().zip(&direct.human_scale_table) {
+        assert_eq!(a, b, "{key}");
+        assert!((s - t).abs() < 1e-6, "{key} {a}: {s} vs {t}");
+    }
+    for (e, f) in bound.ik_match_table2.iter().zip(&direct.ik_match_table2) {
+        assert_eq!((&e.robot_body, &e.human_body), (&f.robot_body, &f.human_body));
+        assert_eq!((e.pos_weight, e.rot_weight), (f.pos_weight, f.rot_weight));
+        assert!(e.rot_offset.angle_to(&f.rot_offset) < 1e-6, "{key} {}", e.robot_body);
+        assert!((e.pos_offset - f.pos_offset).norm() < 1e-6, "{key} {}", e.robot_body);
+    }
+    direct
 }
 
 /// The feet are fitted so that the sole is on the floor when the human rolls onto the ball

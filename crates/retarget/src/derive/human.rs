@@ -320,17 +320,23 @@ impl HumanBody {
         }
         let mut out = self.clone();
         for (role, turn) in &self.arm_twists {
-            if let Some(offset) = out.frame_offsets.get_mut(role) {
-                *offset *= turn.inverse();
-            }
-            for posture in &mut out.postures {
-                if let Some(frame) = posture.frames.get_mut(role) {
-                    *frame *= turn.inverse();
-                }
-            }
+            out.turn(*role, turn.inverse());
         }
         out.arm_twists.clear();
         Cow::Owned(out)
+    }
+
+    /// Turns the canonical frames of `role` by `turn` (on the right: about the frame's own
+    /// axes), its frame offset and every posture's frame.
+    pub(super) fn turn(&mut self, role: Role, turn: UnitQuaternion<f64>) {
+        if let Some(offset) = self.frame_offsets.get_mut(&role) {
+            *offset *= turn;
+        }
+        for posture in &mut self.postures {
+            if let Some(frame) = posture.frames.get_mut(&role) {
+                *frame *= turn;
+            }
+        }
     }
 }
 

@@ -43,7 +43,10 @@
 //!   (fk's frames take their twist from the reference pose, which carries the subject's hip
 //!   rotation there); and the human's foot frame is turned to lie flat on average over the
 //!   frames where the foot is flat on the floor (a reference pose on tiptoe would otherwise
-//!   stand the robot on its toes).
+//!   stand the robot on its toes). For a robot whose shoulder has one or two hinges (servo
+//!   humanoids'), which cannot turn the upper arm about its bone, the human's arm frames are
+//!   also turned back by the mean turn about the bone that the robot's shoulder cannot make
+//!   when it points the upper arm as the human's (`shoulder`).
 //! - **Position offset**, in the body's target frame, **fitted to the motion**: the offset
 //!   that puts the target where the robot's body is when the robot copies the human's
 //!   posture, averaged over up to 256 sampled frames. The copy: the robot's pelvis point at
@@ -70,7 +73,8 @@
 //! A config against the [`HumanBody::canonical`] human names the human side by role
 //! (`pelvis`, `left_thigh`, …): a **role-named config**. [`bind`] turns it into one for a
 //! particular skeleton: names become the skeleton's joints, rotation offsets get the
-//! skeleton's frame offsets (`F_h ⊗ q_off`), scales are rescaled by canonical over skeleton
+//! skeleton's frame offsets (`F_h ⊗ F_c⁻¹ ⊗ q_off`, `F_c` the canonical human's: identity
+//! but for the arm turns of `shoulder`), scales are rescaled by canonical over skeleton
 //! path lengths, position offsets are fitted to the skeleton's motion (keeping what the file
 //! added to the canonical fit), and the height
 //! assumption becomes the skeleton's height (times any factor the file applied to the
@@ -81,8 +85,11 @@ mod fit;
 mod human;
 mod joint_frames;
 mod robot;
+mod shoulder;
 mod weights;
 mod write;
+
+use std::borrow::Cow;
 
 use fk::{Part, Role};
 use mjcf::{Data, Model};
@@ -93,7 +100,8 @@ pub use self::joint_frames::{JointFrames, FRAMES_AGREE, LAFAN1_FRAMES};
 pub use self::weights::WEIGHTS;
 
 use self::fit::fitted_offset;
-use self::robot::robot_side;
+use self::robot::{robot_side, RobotSide};
+use self::shoulder::arm_turns;
 use self::weights::{shoulder_hinges, weights, weights_of};
 use self::write::{entry, file_of, written, Row};
 use crate::config::{ConfigFile, IkConfig, MatchEntry, Ordered};
@@ -138,7 +146,7 @@ fn derived_file(
     source: &str,
 ) -> Result<ConfigFile, Error> {
     let robot = robot_side(model, roles);
-    let human = &*human.for_robot(robot.arms_sideways);
+    let human = &*matched(human, &robot);
     let root_scale = match (robot.paths.get(&Role::Pelvis), human.paths.get(&Role::Pelvis)) {
         (Some(r), Some(h)) if *h > 0.0 => r / h,
         _ => 1.0,
@@ -170,12 +178,30 @@ fn derived_file(
             // A shoulder of two hinges (servo humanoids') cannot take the upper arm's twist:
             // weighed as GMR weighs it, the part it cannot follow turned the shoulder into
             // another branch and pulled the trunk round (a 0.45 m servo robot on the LAFAN1
-            // walk: hands L↔L 0.43 → 0.64, legs' likeness 0.81 → 0.64).
+            // walk: hands L↔L 0.43 → 0.64, legs' likeness 0.81 → 0.64). With the mean turn
+            // it cannot make taken out of the arm frames (`shoulder`), 100 is still no better
+            // (the OP3 URDF's hands L↔L 0.80 → 0.76, legs' likeness 0.44 → 0.50).
             weights[1] = weights_of(Part::Forearm)[1];
         }
         rows.push(Row { role, body: body.clone(), joint: joint.clone(), rot, pos, scale, weights });
     }
     Ok(file_of(&rows, human.height))
+}
+
+/// `human` as `robot` is matched with: [`HumanBody::for_robot`], then the arms of a robot
+/// whose shoulders cannot turn the upper arm about its bone turned to what they can do
+/// ([`arm_turns`]).
+fn matched<'a>(human: &'a HumanBody, robot: &RobotSide) -> Cow<'a, HumanBody> {
+    let human = human.for_robot(robot.arms_sideways);
+    let turns = arm_turns(&human, &robot.shoulders, &robot.frames);
+    if turns.is_empty() {
+        return human;
+    }
+    let mut out = human.into_owned();
+    for (role, turn) in turns {
+        out.turn(role, turn);
+    }
+    Cow::Owned(out)
 }
 
 /// A role-named config ([`derive()`] against [`HumanBody::canonical`]) bound to `human` (see
@@ -197,9 +223,9 @@ fn bound_file(
     model: &Model,
     roles: &RobotRoles,
 ) -> Result<ConfigFile, Error> {
-    let canonical = HumanBody::canonical();
     let robot = robot_side(model, roles);
-    let human = &*human.for_robot(robot.arms_sideways);
+    let canonical = matched(&HumanBody::canonical(), &robot).into_owned();
+    let human = &*matched(human, &robot);
     let frames = &robot.frames;
     let mut data = Data::new(model);
     model.kinematics(&model.qpos0, &mut data);
@@ -235,7 +261,11 @@ fn bound_file(
         let role = role_of(&e.human_body)?;
         let joint = human.joints.get(&role).ok_or_else(|| missing(role))?;
         let frame = human.frame_offsets.get(&role).ok_or_else(|| missing(role))?;
-        let rot = frame * e.rot_offset;
+        // The file's offset from the canonical human's frame (identity but where `matched`
+        // turned it for this robot's arms), put onto this human's.
+        let relative =
+            canonical.frame_offsets.get(&role).map_or(e.rot_offset, |c| c.inverse() * e.rot_offset);
+        let rot = frame * relative;
         let scale = scale_of(&e.human_body)?;
         // The offset fitted to the canonical human is replaced by the one fitted to this
         // human; what the file adds to it (an edit) is kept.
@@ -246,7 +276,7 @@ fn bound_file(
         };
         let written = config.scale_of(&e.human_body).unwrap_or(1.0);
         let fit = |h: &HumanBody, root: f64, s: f64| {
-            fitted_offset(&robot, h, role, origin?, e.rot_offset, root, s)
+            fitted_offset(&robot, h, role, origin?, relative, root, s)
         };
         let pos = match (fit(&canonical, canonical_root, written), fit(human, bound_root, scale)) {
             (Some(c), Some(h)) => e.pos_offset + h - c,

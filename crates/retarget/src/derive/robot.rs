@@ -9,6 +9,7 @@ use mjcf::{Data, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::human::{paths, segments};
+use super::shoulder::{shoulder, Shoulder};
 use crate::robot_roles::RobotRoles;
 
 /// A knee or elbow range whose two sides from straight differ by less than this share of it
@@ -226,6 +227,8 @@ pub(super) struct RobotSide {
     pub(super) arms_sideways: bool,
     /// Per foot role, its sole's primitives ([`sole_geoms`]).
     pub(super) soles: BTreeMap<Role, Vec<SoleGeom>>,
+    /// The arms whose shoulders cannot turn the upper arm about its bone ([`Shoulder`]).
+    pub(super) shoulders: BTreeMap<Side, Shoulder>,
 }
 
 pub(super) fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
@@ -274,6 +277,10 @@ pub(super) fn robot_side(model: &Model, roles: &RobotRoles) -> RobotSide {
         origins,
         hinges,
         soles: sole_geoms(model, &data, roles, &frames),
+        shoulders: [Side::Left, Side::Right]
+            .into_iter()
+            .filter_map(|side| Some((side, shoulder(model, &data, roles, side)?)))
+            .collect(),
         frames,
         arms_sideways,
     }
