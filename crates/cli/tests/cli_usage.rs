@@ -391,3 +391,54 @@ fn report_prints_and_writes_the_motion_over_time_sections() {
     assert_eq!(d["frames_over"].as_u64(), Some(over as u64));
     assert!(rep["root_acceleration"]["target"]["mean_mps2"].is_number());
 }
+
+#[test]
+fn report_measures_against_another_runs_targets() {
+    let Some(clip) = walk(30) else { return };
+    let dir = temp_dir("report-targets-from");
+    let bvh = dir.join("walk.bvh");
+    std::fs::write(&bvh, clip).unwrap();
+    let (mine, gmr) = (dir.join("default.npz"), dir.join("gmr.npz"));
+    for (npz, extra) in [(&mine, None), (&gmr, Some("--gmr"))] {
+        let mut args = vec!["--bvh", bvh.to_str().unwrap(), "--robot", "unitree_g1"];
+        args.extend(["-o", npz.to_str().unwrap()]);
+        args.extend(extra);
+        let out = retarget(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let pelvis = |args: &[&str]| -> f64 {
+        let out = retarget(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = stdout(&out);
+        let line = text.lines().find(|l| l.trim_start().starts_with("pelvis")).unwrap();
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let own = pelvis(&["report", mine.to_str().unwrap()]);
+    let theirs =
+        pelvis(&["report", mine.to_str().unwrap(), "--targets-from", gmr.to_str().unwrap()]);
+    // The default's targets are planted and shifted to the floor: GMR's are not, and the
+    // same motion measures differently against them.
+    assert!((own - theirs).abs() > 1e-3, "{own} cm against its own, {theirs} against GMR's");
+    // --gmr against its own targets, read from another file: the same numbers.
+    let same = pelvis(&["report", gmr.to_str().unwrap(), "--targets-from", gmr.to_str().unwrap()]);
+    assert_eq!(same, pelvis(&["report", gmr.to_str().unwrap()]));
+    // Another clip's motion is refused, naming the file and both frame counts.
+    let short = dir.join("short.bvh");
+    std::fs::write(&short, walk(20).unwrap()).unwrap();
+    let other = dir.join("short.npz");
+    let out = retarget(&[
+        "--bvh",
+        short.to_str().unwrap(),
+        "--robot",
+        "unitree_g1",
+        "--gmr",
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out =
+        retarget(&["report", mine.to_str().unwrap(), "--targets-from", other.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("short.npz") && err.contains("20 frames") && err.contains("30"), "{err}");
+}
