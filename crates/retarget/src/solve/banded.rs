@@ -70,10 +70,11 @@ impl Banded {
 
     /// Sets every block and the right-hand side to zero (the next system of the same size).
     pub fn clear(&mut self) {
+        // (Through the slices: nalgebra's `fill` walks a generic strided iterator.)
         for m in self.diag.iter_mut().chain(&mut self.sub1).chain(&mut self.sub2) {
-            m.fill(0.0);
+            m.as_mut_slice().fill(0.0);
         }
-        self.rhs.fill(0.0);
+        self.rhs.as_mut_slice().fill(0.0);
     }
 
     /// `A_{t,t}`, to add a frame's own terms to (symmetric: both triangles are read).
@@ -172,45 +173,54 @@ impl Banded {
 }
 
 /// The Cholesky factor of the symmetric `a` (its lower triangle read) in place: `a = L Lᵀ`,
-/// the strict upper triangle set to zero. `Err` where a pivot is not positive.
+/// the strict upper triangle set to zero. `Err` where a pivot is not positive. Left-looking
+/// by columns on the column-major storage: every update is an axpy down a contiguous column.
 fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), ()> {
     let n = a.nrows();
+    let m = a.as_mut_slice();
     for j in 0..n {
-        let mut d = a[(j, j)];
+        // Column j below the diagonal, less the contributions of the columns before it.
+        let (done, rest) = m.split_at_mut(j * n);
+        let col = &mut rest[j..n];
         for k in 0..j {
-            d -= a[(j, k)] * a[(j, k)];
+            let ck = &done[k * n + j..k * n + n];
+            let ljk = ck[0];
+            if ljk != 0.0 {
+                col.iter_mut().zip(ck).for_each(|(c, l)| *c -= ljk * l);
+            }
         }
+        let d = col[0];
         if d.is_nan() || d <= 0.0 || d.is_infinite() {
             return Err(());
         }
         let d = d.sqrt();
-        a[(j, j)] = d;
-        for i in j + 1..n {
-            let mut v = a[(i, j)];
-            for k in 0..j {
-                v -= a[(i, k)] * a[(j, k)];
-            }
-            a[(i, j)] = v / d;
-        }
-        for i in 0..j {
-            a[(i, j)] = 0.0;
-        }
+        col[0] = d;
+        let inv = 1.0 / d;
+        col[1..].iter_mut().for_each(|c| *c *= inv);
+        rest[..j].fill(0.0);
     }
     Ok(())
 }
 
-/// `out = l⁻¹` for the lower-triangular `l` (non-zero diagonal), by columns.
+/// `out = l⁻¹` for the lower-triangular `l` (non-zero diagonal), by columns: column `j` is the
+/// forward substitution of `e_j`, each step an axpy down a contiguous column of `l`.
 fn lower_inverse(l: &DMatrix<f64>, out: &mut DMatrix<f64>) {
     let n = l.nrows();
-    out.fill(0.0);
+    let l = l.as_slice();
+    let reciprocal: Vec<f64> = (0..n).map(|k| 1.0 / l[k * n + k]).collect();
+    let o = out.as_mut_slice();
+    o.fill(0.0);
     for j in 0..n {
-        out[(j, j)] = 1.0 / l[(j, j)];
-        for i in j + 1..n {
-            let mut v = 0.0;
-            for k in j..i {
-                v -= l[(i, k)] * out[(k, j)];
+        let x = &mut o[j * n..(j + 1) * n];
+        x[j] = 1.0;
+        for k in j..n {
+            let xk = x[k] * reciprocal[k];
+            x[k] = xk;
+            if xk != 0.0 {
+                x[k + 1..].iter_mut().zip(&l[k * n + k + 1..(k + 1) * n]).for_each(|(v, lv)| {
+                    *v -= xk * lv;
+                });
             }
-            out[(i, j)] = v / l[(i, i)];
         }
     }
 }
