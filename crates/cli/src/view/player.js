@@ -12,7 +12,8 @@
   window.addEventListener('unhandledrejection', (e) => fail(String(e.reason)));
 
   // ---------- data ----------
-  // URL hash: frame=N, paused=1, hide=all (figures off), follow=0, yaw/pitch/dist (camera)
+  // URL hash: frame=N, paused=1, hide=all (figures off), follow=0, yaw/pitch/dist (camera),
+  // height (m: the height the camera looks at, 0.8; 0.05 for the feet)
   const params = new URLSearchParams(location.hash.slice(1));
   function f32(b64) {
     const s = atob(b64);
@@ -481,8 +482,9 @@
   const grid = ren.lineBuffer(gridLines);
   const axes = ren.lineBuffer([0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0.7, 0, 0, 1, 0, 0, 0.7, 0,
     0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1]);
-  const cam = { yaw: -1.1, pitch: 0.3, dist: 3.6, target: main.at(0, 0).slice() };
-  cam.target[2] = 0.8;
+  const cam = { yaw: -1.1, pitch: 0.3, dist: 3.6, height: 0.8, target: main.at(0, 0).slice() };
+  if (params.has('height')) cam.height = parseFloat(params.get('height')) || 0;
+  cam.target[2] = cam.height;
   const state = { frame: 0, playing: true, speed: 1, last: null };
   if (params.has('frame')) state.frame = Math.min(N - 1, Math.max(0, parseInt(params.get('frame'), 10) || 0));
   if (params.get('paused') === '1') state.playing = false;
@@ -529,7 +531,7 @@
 
   function render() {
     const f = Math.round(state.frame);
-    if (follow.checked) { const r = main.at(f, 0); cam.target = [r[0], r[1], 0.8]; }
+    if (follow.checked) { const r = main.at(f, 0); cam.target = [r[0], r[1], cam.height]; }
     const cp = Math.cos(cam.pitch);
     const eye = V.add(cam.target, V.scale([cp * Math.cos(cam.yaw), cp * Math.sin(cam.yaw), Math.sin(cam.pitch)], cam.dist));
     const aspect = canvas.clientWidth / Math.max(1, canvas.clientHeight);
