@@ -56,22 +56,19 @@ impl RobotFoot {
 
     /// The sole's length (m): the spread of its bottom points along its forward direction.
     fn length(&self) -> f64 {
-        let along = self.corners.iter().map(|c| self.forward.dot(c));
-        let (lo, hi) =
-            along.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-        if lo < hi {
-            hi - lo
-        } else {
-            0.0
-        }
+        self.spread_along(&self.forward)
     }
 
     /// The sole's width (m): the spread of its bottom points across its forward direction.
     fn width(&self) -> f64 {
-        let left = self.left();
-        let across = self.corners.iter().map(|c| left.dot(c));
+        self.spread_along(&self.left())
+    }
+
+    /// The spread of the sole's bottom points along `axis` (foot frame; 0 for none).
+    fn spread_along(&self, axis: &Vector3<f64>) -> f64 {
+        let along = self.corners.iter().map(|c| axis.dot(c));
         let (lo, hi) =
-            across.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+            along.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
         if lo < hi {
             hi - lo
         } else {
