@@ -157,13 +157,14 @@ pub use error::Error;
 /// change at any time.
 #[doc(hidden)]
 pub mod internals {
-    pub use crate::constraints::{Constraint, StepContext};
+    pub use crate::constraints::{Constraint, Ground, SelfCollision, StepContext};
     pub use crate::feet::detect_feet;
     pub use crate::joint_speed::JointSpeedLimits;
     pub use crate::lie::{mat_to_quat, Pose};
     pub use crate::marker_config::labelled_points;
     pub use crate::qp::{DenseQp, QpStatus};
     pub use crate::smpl::{frames_from, GMR_FIRST_FRAME};
+    pub use crate::solve::banded::{Banded, NotPositiveDefinite};
     pub use crate::solve::{retarget_bvh, retarget_motion, retarget_motion_chunked, task_specs};
     pub use crate::solver::{PointTask, Solver, TaskSpec};
     pub use crate::targets::{ScaledBody, TargetMap};

@@ -17,7 +17,7 @@
 //! pushes a [`StageReport`] (named after its file: `reweigh`, `uncross`) onto
 //! [`ClipDiagnostics::stages`].
 
-mod banded;
+pub(crate) mod banded;
 mod contacts;
 pub mod dynamics;
 mod first_pass;
