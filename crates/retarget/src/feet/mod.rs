@@ -25,11 +25,12 @@
 //!    stands on its ball alone: it rolls no more with the human's foot, its heel rises up to
 //!    [`FootPlanOptions::pivot_heel_lift`] (2 cm) above its toe and its outer toe corner
 //!    [`CONTACT_PATCH`](soles::CONTACT_PATCH) above the ball, fully where turning flat would
-//!    slide the heel at [`FootPlanOptions::pivot_heel_speed`] (0.2 m/s). (95 % of the frames the report counted
-//!    as skating on the LAFAN1 jumps were flat soles turning at up to 450°/s; at 1.75 m,
-//!    floor skating on the G1's jumps went from 1.40 to 0.31 %, on the T1's from 2.03 to
-//!    1.01 % with the heel up; standing on the one corner took the T1's mid-stance turns out
-//!    of it, where both toe corners had slid at the turn's rate times half the sole's width.)
+//!    slide the heel at [`FootPlanOptions::pivot_heel_speed`] (0.2 m/s). (95 % of the frames
+//!    the report counted as skating on the LAFAN1 jumps were flat soles turning at up to
+//!    450°/s; at 1.75 m, floor skating on the G1's jumps went from 1.40 to 0.31 %, on the
+//!    T1's from 2.03 to 1.01 % with the heel up; standing on the one corner took the T1's
+//!    mid-stance turns out of it, where both toe corners had slid at the turn's rate times
+//!    half the sole's width.)
 //!    A foot whose ankle cannot roll (the H1's) turns about the middle of its toes instead.
 //!    Overlapping stance phases of the two feet are kept apart; where the left foot stands
 //!    to the right of the right one, they are a [`Crossing`], which the solve can ask to be

@@ -164,27 +164,41 @@ impl RobotFoot {
     /// point at rest.
     #[must_use]
     pub fn toe_point(&self) -> Vector3<f64> {
-        let mut corners = self.corners.clone();
-        corners.sort_by(|a, b| self.forward.dot(b).total_cmp(&self.forward.dot(a)));
-        match corners.as_slice() {
-            [a, b, ..] => (a + b) / 2.0,
-            _ => self.sole_low_point(&self.rest),
+        match self.foremost_two() {
+            Some((a, b)) => (a + b) / 2.0,
+            None => self.sole_low_point(&self.rest),
         }
     }
 
-    /// The ball of the foot in the foot frame: of the sole's two foremost bottom points, the
-    /// one on the inner side (towards the other foot: the big toe's), where a foot turning on
-    /// its toes stands; else [`RobotFoot::toe_point`]. `side`: 0 the left foot, 1 the right.
+    /// The ball of the foot in the foot frame, the point a pivot turns about: of the sole's
+    /// two foremost bottom points, the one on the inner side (towards the other foot: the big
+    /// toe's), where a foot turning on its toes stands. A foot whose ankle cannot roll
+    /// ([`RobotFoot::rolls`]) stands on both, and turns about their middle
+    /// ([`RobotFoot::toe_point`]), which slides them least. `side`: 0 the left foot, 1 the
+    /// right.
     #[must_use]
     pub fn ball_point(&self, side: usize) -> Vector3<f64> {
+        let left = self.left();
+        match self.foremost_two() {
+            // The left foot's inner side is its right (−left), the right foot's its left.
+            Some((a, b)) if self.rolls => {
+                if (left.dot(&a) < left.dot(&b)) == (side == 0) {
+                    a
+                } else {
+                    b
+                }
+            }
+            _ => self.toe_point(),
+        }
+    }
+
+    /// The sole's two foremost bottom points (foot frame), foremost first.
+    fn foremost_two(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
         let mut corners = self.corners.clone();
         corners.sort_by(|a, b| self.forward.dot(b).total_cmp(&self.forward.dot(a)));
-        let left = self.left();
         match corners.as_slice() {
-            // The left foot's inner side is its right (−left), the right foot's its left.
-            [a, b, ..] if (left.dot(a) < left.dot(b)) == (side == 0) => *a,
-            [_, b, ..] => *b,
-            _ => self.toe_point(),
+            [a, b, ..] => Some((*a, *b)),
+            _ => None,
         }
     }
 

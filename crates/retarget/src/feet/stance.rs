@@ -77,10 +77,11 @@ impl RobotFoot {
     }
 
     /// `rot` rolled about the foot's own forward axis so that the sole's outer edge (the left
-    /// foot's left, `side` 0; the right foot's right) rises `lift` (m) above its inner edge.
+    /// foot's left, `side` 0; the right foot's right) rises `lift` (m) above its inner edge;
+    /// unchanged where the ankle cannot roll ([`RobotFoot::rolls`]).
     fn outside_up(&self, rot: &UnitQuaternion<f64>, lift: f64, side: usize) -> UnitQuaternion<f64> {
         let width = self.width();
-        if lift <= 0.0 || width <= lift {
+        if !self.rolls || lift <= 0.0 || width <= lift {
             return *rot;
         }
         // A positive turn about forward raises the left edge.
@@ -147,9 +148,7 @@ pub(super) fn plant(
     options: &FootPlanOptions,
 ) -> Vec<Option<Pose>> {
     let mut planted = vec![None; free.len()];
-    // A foot whose ankle cannot roll stands on its toes, two points: it turns about their
-    // middle, which slides them least.
-    let ball = if foot.rolls { foot.ball_point(side) } else { foot.toe_point() };
+    let ball = foot.ball_point(side);
     for (r, xy, yaw) in phases {
         let (xy, yaw) = (*xy, *yaw);
         let pivots = turn_of(&free_yaw[r.clone()], yaw) > options.pivot_turn;
@@ -169,7 +168,7 @@ pub(super) fn plant(
             let q =
                 foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t] * (1.0 - turning));
             let q = foot.heel_up(&q, turning * options.pivot_heel_lift);
-            let q = if foot.rolls { foot.outside_up(&q, turning * CONTACT_PATCH, side) } else { q };
+            let q = foot.outside_up(&q, turning * CONTACT_PATCH, side);
             let rolled = Pose { quat: [q.w, q.i, q.j, q.k], pos: free[t].pos };
             planted[t] = Some(planted_pose(foot, &rolled, xy, yaw, options.clearance));
         }
