@@ -52,6 +52,16 @@ pub struct ClipResult {
     pub metrics: serde_json::Value,
     /// What was inferred about the source, one line (`fk::FkReport::inferred`).
     pub inferred: Option<String>,
+    /// The report's verdict, when the clip was measured.
+    pub verdict: Option<ClipVerdict>,
+}
+
+/// A clip's verdict in `summary.json`: ok, or the names of the checks that broke their caps
+/// (their values and caps are in the row's `metrics.verdict`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ClipVerdict {
+    pub ok: bool,
+    pub flags: Vec<String>,
 }
 
 /// One row of `summary.json`.
@@ -69,6 +79,8 @@ pub struct ClipSummary {
     pub seconds: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub frames_per_second: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub verdict: Option<ClipVerdict>,
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub metrics: Option<serde_json::Value>,
     /// Up axis, unit, skeleton roles and rest pose inferred from the source.
@@ -99,6 +111,11 @@ pub struct Totals {
     pub frames: usize,
     /// Wall time of the run(s), seconds (merged: the sum over shards).
     pub seconds: f64,
+    /// Converted clips whose verdict is not ok, and per check name how many clips broke it.
+    #[serde(default)]
+    pub flagged: usize,
+    #[serde(default)]
+    pub flags: BTreeMap<String, usize>,
 }
 
 impl Summary {
@@ -110,6 +127,17 @@ impl Summary {
         self.totals.failed = count("failed");
         self.totals.frames =
             self.clips.iter().filter(|c| c.status == "converted").filter_map(|c| c.frames).sum();
+        let verdicts = || self.clips.iter().filter_map(|c| c.verdict.as_ref());
+        self.totals.flagged = verdicts().filter(|v| !v.ok).count();
+        self.totals.flags.clear();
+        for name in verdicts().flat_map(|v| &v.flags) {
+            *self.totals.flags.entry(name.clone()).or_default() += 1;
+        }
+    }
+
+    /// Converted clips whose verdict is not ok.
+    pub fn flagged(&self) -> impl Iterator<Item = &ClipSummary> {
+        self.clips.iter().filter(|c| c.verdict.as_ref().is_some_and(|v| !v.ok))
     }
 
     /// The name of the summary file a run writes into the output directory.
@@ -271,6 +299,7 @@ where
         frames: None,
         seconds: None,
         frames_per_second: None,
+        verdict: None,
         metrics: None,
         inferred: None,
         error: None,
@@ -293,6 +322,7 @@ where
             row.seconds = Some(seconds);
             row.frames_per_second = Some(clip.frames as f64 / seconds.max(1e-9));
             row.metrics = Some(clip.metrics);
+            row.verdict = clip.verdict;
             let inferred = clip.inferred.as_deref().map_or(String::new(), |i| format!("; {i}"));
             progress.clip_done(
                 &row.input,
@@ -479,11 +509,35 @@ mod tests {
             panic!("a bug met {}", text.len());
         }
         crate::atomic_write(output, text.to_uppercase().as_bytes())?;
+        let flagged = text.contains("flag");
+        let flags = if flagged { vec!["self_collision".to_owned()] } else { Vec::new() };
         Ok(ClipResult {
             frames: text.len(),
             metrics: serde_json::json!({"len": text.len()}),
             inferred: None,
+            verdict: Some(ClipVerdict { ok: !flagged, flags }),
         })
+    }
+
+    #[test]
+    fn verdicts_are_written_and_counted_per_flag() {
+        let input = tree(&["a.bvh", "b/flagged.bvh", "c_flagged.bvh"]);
+        let output = tempdir::Dir::new();
+        let summary = run(&plan(input.path(), output.path(), false), fake_convert).unwrap();
+        assert_eq!((summary.totals.converted, summary.totals.flagged), (3, 2));
+        assert_eq!(summary.totals.flags.get("self_collision"), Some(&2));
+        let names: Vec<&str> = summary.flagged().map(|c| c.input.as_str()).collect();
+        assert_eq!(names, ["b/flagged.bvh", "c_flagged.bvh"]);
+        let written: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(output.path().join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(written["clips"][0]["verdict"]["ok"], true);
+        assert_eq!(written["clips"][1]["verdict"]["flags"][0], "self_collision");
+        assert_eq!(written["totals"]["flagged"], 2);
+        // A resumed run skips the clips and so measures none: nothing flagged.
+        let again = run(&plan(input.path(), output.path(), false), fake_convert).unwrap();
+        assert_eq!((again.totals.skipped, again.totals.flagged), (3, 0));
     }
 
     #[test]
@@ -546,6 +600,7 @@ mod tests {
             frames: (status == "converted").then_some(10),
             seconds: None,
             frames_per_second: None,
+            verdict: None,
             metrics: None,
             inferred: None,
             error: None,

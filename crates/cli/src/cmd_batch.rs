@@ -73,6 +73,10 @@ pub struct BatchArgs {
     pub lead_in: usize,
     #[command(flatten)]
     pub smpl: crate::cmd_smpl::ModelArgs,
+    /// Exit with code 3 when a converted clip's verdict is flagged (a measure past its cap:
+    /// `retarget report`'s verdict, docs/metrics.md); failures still exit with 1.
+    #[arg(long)]
+    pub fail_on_flag: bool,
     /// Merge shard summaries (summary-shard-K-of-N.json files) into one JSON file (-o).
     #[arg(long, num_args = 1.., value_name = "SUMMARY", conflicts_with_all = ["input", "robot", "config", "shard"])]
     pub merge_summaries: Vec<PathBuf>,
@@ -127,7 +131,7 @@ pub fn run(args: BatchArgs) -> anyhow::Result<ExitCode> {
     let summary = batch::run(&plan, |src: &Path, dst: &Path| job.convert_file(src, dst))?;
     print_table(&summary);
     eprintln!("batch: summary in {}", output.join(Summary::file_name(args.shard)).display());
-    Ok(if summary.totals.failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(exit_code(&summary, args.fail_on_flag))
 }
 
 fn merge(parts: &[PathBuf], output: &Path) -> anyhow::Result<ExitCode> {
@@ -143,7 +147,18 @@ fn merge(parts: &[PathBuf], output: &Path) -> anyhow::Result<ExitCode> {
     let merged = Summary::merge(&summaries)?;
     crate::atomic_write(output, (serde_json::to_string_pretty(&merged)? + "\n").as_bytes())?;
     print_table(&merged);
-    Ok(if merged.totals.failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(exit_code(&merged, false))
+}
+
+/// 1 when a clip failed, else 3 when `fail_on_flag` and a clip was flagged, else 0.
+fn exit_code(summary: &Summary, fail_on_flag: bool) -> ExitCode {
+    if summary.totals.failed > 0 {
+        ExitCode::from(1)
+    } else if fail_on_flag && summary.totals.flagged > 0 {
+        ExitCode::from(3)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
 
 fn print_table(summary: &Summary) {
@@ -155,6 +170,16 @@ fn print_table(summary: &Summary) {
     );
     for clip in summary.clips.iter().filter(|c| c.status == "failed") {
         println!("  failed  {}: {}", clip.input, clip.error.as_deref().unwrap_or("?"));
+    }
+    let measured = summary.clips.iter().filter(|c| c.verdict.is_some()).count();
+    if measured > 0 {
+        let by: Vec<String> = t.flags.iter().map(|(name, n)| format!("{name} {n}")).collect();
+        let by = if by.is_empty() { String::new() } else { format!(" ({})", by.join(", ")) };
+        println!("verdicts: {} of {measured} clips flagged{by}", t.flagged);
+    }
+    for clip in summary.flagged() {
+        let flags = clip.verdict.as_ref().map(|v| v.flags.join(", ")).unwrap_or_default();
+        println!("  flagged {}: {flags}", clip.input);
     }
 }
 
@@ -255,6 +280,7 @@ impl Job {
             frames: motion.num_frames(),
             metrics: serde_json::to_value(&quality)?,
             inferred: Some(diag.human_inferred),
+            verdict: Some(clip_verdict(&quality.verdict)),
         })
     }
 }
@@ -331,4 +357,9 @@ fn remove_stale_temporaries(dst: &Path) {
             let _ = std::fs::remove_file(entry.path());
         }
     }
+}
+
+/// A report's verdict as a summary row carries it: ok and the names of the broken checks.
+fn clip_verdict(verdict: &retarget::report::Verdict) -> batch::ClipVerdict {
+    batch::ClipVerdict { ok: verdict.ok, flags: verdict.flag_names().map(str::to_owned).collect() }
 }

@@ -163,9 +163,11 @@ mod dynamics;
 mod feet;
 mod rates;
 mod text;
+mod verdict;
 
-pub use dynamics::{CentreOfPressure, Dynamics, DynamicsOptions, Flight, FrameDynamics};
-pub use rates::{AccelStats, Jitter, RootAcceleration, GRAVITY};
+pub use dynamics::{half_step, CentreOfPressure, Dynamics, DynamicsOptions, Flight, FrameDynamics};
+pub use rates::{AccelStats, AveragedAcceleration, Jitter, RootAcceleration, GRAVITY};
+pub use verdict::{Caps, Check, GmrCaps, Verdict};
 
 use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
@@ -218,8 +220,10 @@ pub struct ReportOptions {
     /// to the chest). `None`: the motion's first target (GMR's configs, the shipped and the
     /// derived ones begin their match table with the root).
     pub root_target: Option<String>,
-    /// The dynamics check's contacts, friction and thresholds.
+    /// The dynamics check's contacts, friction, thresholds and averaging time.
     pub dynamics: DynamicsOptions,
+    /// The verdict's caps.
+    pub caps: Caps,
 }
 
 impl Default for ReportOptions {
@@ -241,6 +245,7 @@ impl Default for ReportOptions {
             position_targets: None,
             root_target: None,
             dynamics: DynamicsOptions::default(),
+            caps: Caps::default(),
         }
     }
 }
@@ -426,6 +431,8 @@ pub struct JointSpeedLimits {
 /// The quality report of one motion (serialises to JSON; `Display` prints a table).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct QualityReport {
+    /// Every measure against its cap; printed first.
+    pub verdict: Verdict,
     pub robot: String,
     pub frames: usize,
     pub fps: f64,
@@ -449,10 +456,14 @@ pub struct QualityReport {
     pub root_acceleration: RootAcceleration,
     /// Mean `|q̈|` over every velocity coordinate, the root's included.
     pub jitter: Jitter,
-    /// The dynamics check; `None` when the model's masses are not known or the clip is
-    /// shorter than 5 frames ([`QualityReport::dynamics_unavailable`] says why).
+    /// The dynamics check, accelerations averaged over [`DynamicsOptions::span`]; `None`
+    /// when the model's masses are not known or the clip is shorter than the span
+    /// ([`QualityReport::dynamics_unavailable`] says why).
     pub dynamics: Option<Dynamics>,
     pub dynamics_unavailable: Option<String>,
+    /// The same check on the 5 frames around each frame whatever the rate (the figure of
+    /// earlier reports, kept beside for continuity; equal to `dynamics` at 24–35 fps).
+    pub dynamics_5_frame: Option<Dynamics>,
 }
 
 /// Computes the [`QualityReport`] of `motion` on `model` (the robot it was solved for).
@@ -486,7 +497,7 @@ pub fn report(
         })
         .collect();
     let root: Vec<f64> = (0..frames).map(|t| poses.pos(t, 0).z).collect();
-    let (ground_penetration, self_collision) = collisions(motion, model, opts);
+    let (ground_penetration, self_collision, self_depth) = collisions(motion, model, opts);
     // Skating is measured at the toe point of the sole (holosoma: a toe body), else at the
     // foot body's origin.
     let toe = feet.map(|f| {
@@ -498,13 +509,26 @@ pub fn report(
         (0..frames).map(|t| (poses.pos(t, b) + (poses.quat(t, b) * toe[i])).xy()).collect()
     });
     let contacts = motion.contacts.as_ref().map(|c| [&c.left[..], &c.right[..]]);
-    let (dynamics, dynamics_unavailable) =
-        match dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics) {
-            Ok(c) if c.frames.is_empty() => (None, Some("fewer than 5 frames".to_owned())),
-            Ok(c) => (Some(dynamics::summarise(&c, &opts.dynamics)), None),
-            Err(reason) => (None, Some(reason)),
-        };
-    Ok(QualityReport {
+    let h = half_step(motion.fps, opts.dynamics.span);
+    let check = |half| match dynamics::check(
+        motion,
+        model,
+        &poses,
+        opts.ground_height,
+        &opts.dynamics,
+        half,
+    ) {
+        Ok(c) if c.frames.is_empty() => Err(format!("fewer than {} frames", 4 * c.half_step + 1)),
+        Ok(c) => Ok(dynamics::summarise(&c, &opts.dynamics)),
+        Err(reason) => Err(reason),
+    };
+    let (dynamics, dynamics_unavailable) = match check(Some(h)) {
+        Ok(d) => (Some(d), None),
+        Err(reason) => (None, Some(reason)),
+    };
+    let dynamics_5_frame = if h == 1 { dynamics.clone() } else { check(Some(1)).ok() };
+    let mut rep = QualityReport {
+        verdict: Verdict { ok: true, flags: Vec::new(), checks: Vec::new() },
         robot: model.name.clone(),
         frames,
         fps: motion.fps,
@@ -524,16 +548,25 @@ pub fn report(
             model,
             &poses,
             opts.root_target.as_deref(),
+            h,
         ),
         jitter: rates::jitter(motion, model),
         dynamics,
         dynamics_unavailable,
-    })
+        dynamics_5_frame,
+    };
+    let series = verdict::Series {
+        feet: [&heights[0].0, &heights[1].0],
+        self_depth: &self_depth,
+        contact_height: opts.contact_height,
+    };
+    rep.verdict = verdict::verdict(&rep, motion, model, &series, &opts.caps);
+    Ok(rep)
 }
 
-/// The dynamics check of every checked frame (frames 2..T−3; module documentation), e.g. to
-/// find the frames behind [`QualityReport::dynamics`]. An [`Error::Options`] when the model's
-/// masses are not known.
+/// The dynamics check of every checked frame (frames 2h..T−1−2h, accelerations averaged over
+/// [`DynamicsOptions::span`]; module documentation), e.g. to find the frames behind
+/// [`QualityReport::dynamics`]. An [`Error::Options`] when the model's masses are not known.
 pub fn dynamics_frames(
     motion: &RobotMotion,
     model: &mjcf::Model,
@@ -541,17 +574,18 @@ pub fn dynamics_frames(
 ) -> Result<Vec<FrameDynamics>, Error> {
     check_motion(motion, model)?;
     let poses = body_poses(motion, model);
-    dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics)
+    dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics, None)
         .map(|c| c.frames)
         .map_err(Error::Options)
 }
 
-/// Ground penetration of every collision geom and self-collision, in one pass of FK.
+/// Ground penetration of every collision geom and self-collision, in one pass of FK; and per
+/// frame the deepest self-collision (m, 0 without any).
 fn collisions(
     motion: &RobotMotion,
     model: &mjcf::Model,
     opts: &ReportOptions,
-) -> (GroundPenetration, SelfCollision) {
+) -> (GroundPenetration, SelfCollision, Vec<f64>) {
     let geoms = crate::constraints::collision_primitives(model);
     let mut data = mjcf::Data::new(model);
     let selection = model.self_collision_pairs();
@@ -575,6 +609,7 @@ fn collisions(
         worst_pair: None,
     };
     let (mut worst_geom, mut worst_pair) = (None, None);
+    let mut self_depth = Vec::with_capacity(motion.num_frames());
     for t in 0..motion.num_frames() {
         model.kinematics(motion.frame(t), &mut data);
         let mut depth = 0.0f64;
@@ -598,13 +633,14 @@ fn collisions(
                 (own.max_depth_cm, worst_pair) = (-p.distance * 100.0, Some([g1, g2]));
             }
         }
+        self_depth.push(deepest.unwrap_or(0.0));
         own.frames_penetrating += usize::from(deepest.is_some());
         own.frames_deep += usize::from(deepest.is_some_and(|d| d > opts.self_collision_depth));
     }
     ground.duration = ratio(ground.frames, motion.num_frames());
     ground.worst_geom = worst_geom.map(|g| model.geom_label(g));
     own.worst_pair = worst_pair.map(|[a, b]| [model.geom_label(a), model.geom_label(b)]);
-    (ground, own)
+    (ground, own, self_depth)
 }
 
 fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedLimits> {

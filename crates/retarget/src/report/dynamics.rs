@@ -32,6 +32,23 @@ pub struct DynamicsOptions {
     /// The centre of pressure counts as outside the support polygon beyond this (m).
     /// Default 0.01.
     pub cop_tolerance: f64,
+    /// The time the averaged accelerations read (s): velocities and their rates are central
+    /// differences over `h` frames, `h = max(1, round(fps · span / 4))` ([`half_step`]), so
+    /// the centre of mass's acceleration reads the `4h + 1` frames of about `span` around a
+    /// frame whatever the clip's rate (5 frames at 30 fps, 21 at 120). Default 1/6 s.
+    pub span: f64,
+}
+
+/// The half step `h` (frames) of the averaged accelerations at `fps` over `span` seconds
+/// ([`DynamicsOptions::span`]): `max(1, round(fps · span / 4))`.
+#[must_use]
+pub fn half_step(fps: f64, span: f64) -> usize {
+    let h = (fps * span / 4.0).round();
+    if h.is_finite() && h >= 1.0 {
+        h as usize
+    } else {
+        1
+    }
 }
 
 impl Default for DynamicsOptions {
@@ -42,6 +59,7 @@ impl Default for DynamicsOptions {
             cone_edges: 8,
             threshold: 0.1,
             cop_tolerance: 0.01,
+            span: 1.0 / 6.0,
         }
     }
 }
@@ -107,7 +125,11 @@ pub struct Dynamics {
     pub contact_height_cm: f64,
     /// [`DynamicsOptions::threshold`] (m·g).
     pub threshold_mg: f64,
-    /// Frames checked: every frame two away from the ends.
+    /// The half step `h` of the averaged accelerations (frames; [`half_step`]) and the time
+    /// they read, `4h / fps` (s): 1 and 0.133 s at 30 fps, 5 and 0.167 s at 120 fps.
+    pub half_step_frames: usize,
+    pub window_s: f64,
+    /// Frames checked: every frame `2h` away from the ends.
     pub frames: usize,
     /// Residual wrench (m·g) over the checked frames; its force (m·g) and torque (m·g·L)
     /// parts.
@@ -164,24 +186,25 @@ fn centres(
     (each, com)
 }
 
-/// Centroidal angular momentum at frame t (1 ≤ t ≤ T − 2) from central differences:
-/// `Σ m_i (x_i − c) × ẋ_i + R_i I_i R_iᵀ ω_i`.
+/// Centroidal angular momentum at frame t (h ≤ t ≤ T − 1 − h) from central differences over
+/// `h` frames: `Σ m_i (x_i − c) × ẋ_i + R_i I_i R_iᵀ ω_i`.
 fn angular_momentum(
     bodies: &[MassBody],
     poses: &BodyPoses,
     each: &[Vector3<f64>],
     com: &Vector3<f64>,
-    t: usize,
+    (t, h): (usize, usize),
     fps: f64,
 ) -> Vector3<f64> {
     let n = bodies.len();
+    let rate = fps / (2 * h) as f64;
     let mut l = Vector3::zeros();
     for (i, b) in bodies.iter().enumerate() {
         let m = b.inertial.mass;
-        let v = (each[(t + 1) * n + i] - each[(t - 1) * n + i]) * (fps / 2.0);
-        let (q0, q1) = (poses.quat(t - 1, b.pose), poses.quat(t + 1, b.pose));
-        // World angular velocity: q(t+1) = exp(ω 2Δt) q(t−1).
-        let w = (q1 * q0.inverse()).scaled_axis() * (fps / 2.0);
+        let v = (each[(t + h) * n + i] - each[(t - h) * n + i]) * rate;
+        let (q0, q1) = (poses.quat(t - h, b.pose), poses.quat(t + h, b.pose));
+        // World angular velocity: q(t+h) = exp(ω 2hΔt) q(t−h).
+        let w = (q1 * q0.inverse()).scaled_axis() * rate;
         let rot: UnitQuaternion<f64> = poses.quat(t, b.pose) * b.inertial.quat;
         let local = rot.inverse() * w;
         let spin = rot * local.component_mul(&b.inertial.diag);
@@ -190,37 +213,44 @@ fn angular_momentum(
     l
 }
 
-/// The per-frame checks with the total mass (kg) and the torque unit's length `L` (m).
+/// The per-frame checks with the total mass (kg), the torque unit's length `L` (m) and the
+/// half step `h` (frames).
 pub(super) struct Checked {
     pub frames: Vec<FrameDynamics>,
     pub mass: f64,
     pub lever: f64,
+    pub half_step: usize,
+    pub fps: f64,
 }
 
-/// Per checked frame (2 ≤ t ≤ T − 3), the dynamics check; or why the model's masses are not
-/// known. `ground` is the floor's height.
+/// Per checked frame (2h ≤ t ≤ T − 1 − 2h), the dynamics check with accelerations averaged
+/// over the half step `h` (frames; `None`: [`half_step`] of the clip's rate and
+/// [`DynamicsOptions::span`]; `Some(1)`: the 5-frame figure); or why the model's masses are
+/// not known. `ground` is the floor's height.
 pub(super) fn check(
     motion: &RobotMotion,
     model: &mjcf::Model,
     poses: &BodyPoses,
     ground: f64,
     opts: &DynamicsOptions,
+    half: Option<usize>,
 ) -> Result<Checked, String> {
     let bodies = mass_bodies(model)?;
     let mass: f64 = bodies.iter().map(|b| b.inertial.mass).sum();
     let geoms = crate::constraints::collision_primitives(model);
     let lever = lever(model, &bodies, &geoms);
     let (frames, fps) = (motion.num_frames(), motion.fps);
-    if frames < 5 {
-        return Ok(Checked { frames: Vec::new(), mass, lever });
+    let h = half.unwrap_or_else(|| half_step(fps, opts.span)).max(1);
+    if frames < 4 * h + 1 {
+        return Ok(Checked { frames: Vec::new(), mass, lever, half_step: h, fps });
     }
     let (each, com) = centres(&bodies, poses, frames);
     let momentum: Vec<Vector3<f64>> = (0..frames)
         .map(|t| {
-            if t == 0 || t + 1 == frames {
+            if t < h || t + h >= frames {
                 Vector3::zeros()
             } else {
-                angular_momentum(&bodies, poses, &each, &com[t], t, fps)
+                angular_momentum(&bodies, poses, &each, &com[t], (t, h), fps)
             }
         })
         .collect();
@@ -235,16 +265,17 @@ pub(super) fn check(
     let weight = mass * GRAVITY;
     let edges = cone_edges(opts.friction, opts.cone_edges.max(3));
     let (mut cols, mut x, mut contact) = (Vec::<Column>::new(), Vec::new(), Vec::new());
-    let mut out = Vec::with_capacity(frames - 4);
-    for t in 2..frames - 2 {
+    let mut out = Vec::with_capacity(frames - 4 * h);
+    let span = (2 * h) as f64;
+    for t in 2 * h..frames - 2 * h {
         let c = com[t];
-        let acc = (com[t + 2] - com[t] * 2.0 + com[t - 2]) * (fps * fps / 4.0);
+        let acc = (com[t + 2 * h] - com[t] * 2.0 + com[t - 2 * h]) * (fps * fps / (span * span));
         let force = (acc + Vector3::z() * GRAVITY) * mass;
-        let torque = (momentum[t + 1] - momentum[t - 1]) * (fps / 2.0);
+        let torque = (momentum[t + h] - momentum[t - h]) * (fps / span);
         frame_points(model, poses, &geoms, t, &mut points);
         contact.clear();
         contact.extend(
-            (0..count).filter(|&k| (t - 1..=t + 1).any(|s| near[s * count + k])).map(|k| points[k]),
+            (0..count).filter(|&k| (t - h..=t + h).any(|s| near[s * count + k])).map(|k| points[k]),
         );
         let f = force / weight;
         let b: Column = [
@@ -279,7 +310,7 @@ pub(super) fn check(
             cop_outside,
         });
     }
-    Ok(Checked { frames: out, mass, lever })
+    Ok(Checked { frames: out, mass, lever, half_step: h, fps })
 }
 
 /// The needed wrench's zero-moment point on the floor (the point about which its moment has
@@ -362,7 +393,7 @@ fn outside(hull: &[Vector2<f64>], p: &Vector2<f64>) -> f64 {
 
 /// The dynamics section of the report from the per-frame checks.
 pub(super) fn summarise(checked: &Checked, opts: &DynamicsOptions) -> Dynamics {
-    let Checked { frames, mass, lever } = checked;
+    let Checked { frames, mass, lever, half_step, fps } = checked;
     let (mass, lever) = (*mass, *lever);
     let pick = |f: fn(&FrameDynamics) -> f64, keep: fn(&FrameDynamics) -> bool| -> Vec<f64> {
         frames.iter().filter(|d| keep(d)).map(f).collect()
@@ -380,6 +411,8 @@ pub(super) fn summarise(checked: &Checked, opts: &DynamicsOptions) -> Dynamics {
         cone_edges: opts.cone_edges.max(3),
         contact_height_cm: opts.contact_height * 100.0,
         threshold_mg: opts.threshold,
+        half_step_frames: *half_step,
+        window_s: (4 * half_step) as f64 / fps,
         frames: frames.len(),
         residual_mg: stats(&residual),
         residual_force_mg: stats(&pick(|d| d.residual_force, |_| true)),

@@ -44,6 +44,22 @@ pub struct RootAcceleration {
     pub target: Option<AccelStats>,
     /// The body of that target ([`super::ReportOptions::root_target`]).
     pub target_body: Option<String>,
+    /// The same accelerations averaged over the dynamics check's time
+    /// ([`super::DynamicsOptions::span`]), so that a 120 fps clip is judged on its motion,
+    /// not on the finite-difference noise of one frame's 8 ms.
+    pub averaged: AveragedAcceleration,
+}
+
+/// Root accelerations averaged over about [`super::DynamicsOptions::span`]: at frame t,
+/// `|p[t+2h] − 2 p[t] + p[t−2h]| · fps² / (2h)²`, `h` the dynamics check's half step
+/// ([`super::half_step`]), over the frames `2h` away from the ends.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AveragedAcceleration {
+    /// `h` (frames) and the time read, `4h / fps` (s).
+    pub half_step_frames: usize,
+    pub window_s: f64,
+    pub motion: AccelStats,
+    pub target: Option<AccelStats>,
 }
 
 /// Mean `|q̈|` over every velocity coordinate (MuJoCo's nv), by group.
@@ -64,14 +80,14 @@ pub struct Jitter {
     pub all: f64,
 }
 
-/// Root acceleration of the motion and of its root target.
 /// Root acceleration of the motion and of the target of `root_target` (the first target
-/// when `None`).
+/// when `None`), frame by frame and averaged over the half step `h` (frames).
 pub(super) fn root_acceleration(
     motion: &RobotMotion,
     model: &mjcf::Model,
     poses: &BodyPoses,
     root_target: Option<&str>,
+    h: usize,
 ) -> RootAcceleration {
     let frames = motion.num_frames();
     let robot: Vec<Vector3<f64>> = (0..frames).map(|t| poses.pos(t, 0)).collect();
@@ -84,22 +100,33 @@ pub(super) fn root_acceleration(
             None => return None,
         };
         let p: Vec<Vector3<f64>> = (0..frames).map(|t| targets.pos[t * k + j]).collect();
-        Some((accel_stats(&p, motion.fps), targets.body_names[j].clone()))
+        Some((p, targets.body_names[j].clone()))
     });
     let (target, target_body) = target.unzip();
+    let fps = motion.fps;
     RootAcceleration {
         body,
         threshold_mps2: 2.0 * GRAVITY,
-        motion: accel_stats(&robot, motion.fps),
-        target,
+        motion: accel_stats(&robot, fps, 1),
+        target: target.as_ref().map(|p| accel_stats(p, fps, 1)),
         target_body,
+        averaged: AveragedAcceleration {
+            half_step_frames: h,
+            window_s: (4 * h) as f64 / fps,
+            motion: accel_stats(&robot, fps, 2 * h),
+            target: target.as_ref().map(|p| accel_stats(p, fps, 2 * h)),
+        },
     }
 }
 
-/// `|p[t+1] − 2 p[t] + p[t−1]| · fps²` over the interior frames.
+/// `|p[t+s] − 2 p[t] + p[t−s]| · fps² / s²` over the frames `s` away from the ends (`s = 1`:
+/// the interior frames).
 #[must_use]
-pub(super) fn accel_stats(p: &[Vector3<f64>], fps: f64) -> AccelStats {
-    let a: Vec<f64> = p.windows(3).map(|w| (w[2] - 2.0 * w[1] + w[0]).norm() * fps * fps).collect();
+pub(super) fn accel_stats(p: &[Vector3<f64>], fps: f64, s: usize) -> AccelStats {
+    let rate = fps / s as f64;
+    let a: Vec<f64> = (s..p.len().saturating_sub(s))
+        .map(|t| (p[t + s] - 2.0 * p[t] + p[t - s]).norm() * rate * rate)
+        .collect();
     let frames_over = a.iter().filter(|a| **a > 2.0 * GRAVITY).count();
     AccelStats {
         frames: a.len(),

@@ -8,11 +8,15 @@ use super::*;
 impl fmt::Display for QualityReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let secs = self.frames as f64 / self.fps;
+        self.fmt_verdict(f)?;
         writeln!(
             f,
             "robot {} · {} frames at {} fps ({secs:.2} s)",
             self.robot, self.frames, self.fps
         )?;
+        if self.tracking.is_none() {
+            writeln!(f, "tracking: - (no targets in the motion: tracking error not measured)")?;
+        }
         if let Some(tracking) = &self.tracking {
             writeln!(f, "\ntracking error           position (cm) mean / p95 / max   rotation (rad) mean / p95 / max")?;
             for b in tracking {
@@ -155,6 +159,33 @@ impl QualityReport {
         self.fmt_over_time(f)
     }
 
+    /// The verdict: ok or the flags with their caps, then what was not measured.
+    fn fmt_verdict(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = &self.verdict;
+        let measured = v.checks.iter().filter(|c| c.ok.is_some()).count();
+        if v.ok {
+            writeln!(f, "verdict: ok ({measured} checks within their caps)")?;
+        } else {
+            let names: Vec<&str> = v.flag_names().collect();
+            writeln!(f, "verdict: FLAGGED: {}", names.join(", "))?;
+            for c in &v.flags {
+                writeln!(
+                    f,
+                    "  {}: {} (cap {} {}): {}",
+                    c.name,
+                    num(c.value),
+                    num(c.cap),
+                    c.unit,
+                    c.detail
+                )?;
+            }
+        }
+        for c in v.checks.iter().filter(|c| c.ok.is_none()) {
+            writeln!(f, "  not checked: {}: {}", c.name, c.detail)?;
+        }
+        writeln!(f)
+    }
+
     /// Root acceleration, jitter over nv and the dynamics check, one line or two each.
     fn fmt_over_time(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let r = &self.root_acceleration;
@@ -167,9 +198,20 @@ impl QualityReport {
                 a.max_mps2
             )
         };
-        writeln!(f, "\nroot acceleration ({}): {}", r.body, accel(&r.motion))?;
-        if let (Some(t), Some(body)) = (&r.target, &r.target_body) {
+        let a = &r.averaged;
+        writeln!(
+            f,
+            "\nroot acceleration ({}, averaged over {:.3} s): {}",
+            r.body,
+            a.window_s,
+            accel(&a.motion)
+        )?;
+        if let (Some(t), Some(body)) = (&a.target, &r.target_body) {
             writeln!(f, "  scaled human (target of {body}): {}", accel(t))?;
+        }
+        writeln!(f, "  frame by frame: {}", accel(&r.motion))?;
+        if let Some(t) = &r.target {
+            writeln!(f, "  scaled human, frame by frame: {}", accel(t))?;
         }
         let j = &self.jitter;
         let opt = |v: Option<f64>| v.map_or_else(|| "-".to_owned(), |v| format!("{v:.2}"));
@@ -188,12 +230,13 @@ impl QualityReport {
         };
         writeln!(
             f,
-            "dynamics ({:.1} kg, L {:.2} m, μ {}, {}-edge cones, contact within {:.1} cm): residual wrench mean {:.3} / p95 {:.3} / max {:.3} m·g; {} of {} frames ({:.1}%) over {} m·g ({} of {} support frames)",
+            "dynamics ({:.1} kg, L {:.2} m, μ {}, {}-edge cones, contact within {:.1} cm, accelerations over {:.3} s): residual wrench mean {:.3} / p95 {:.3} / max {:.3} m·g; {} of {} frames ({:.1}%) over {} m·g ({} of {} support frames)",
             d.mass_kg,
             d.lever_m,
             d.friction,
             d.cone_edges,
             d.contact_height_cm,
+            d.window_s,
             d.residual_mg.mean,
             d.residual_mg.p95,
             d.residual_mg.max,
@@ -226,6 +269,31 @@ impl QualityReport {
             fl.frames_over,
             fl.share_over * 100.0,
             d.threshold_mg
-        )
+        )?;
+        if let Some(five) = self
+            .dynamics_5_frame
+            .as_ref()
+            .filter(|five| five.half_step_frames != d.half_step_frames)
+        {
+            writeln!(
+                f,
+                "  on 5 frames ({:.3} s, the earlier figure): {} of {} frames ({:.1}%) over {} m·g",
+                five.window_s,
+                five.frames_over,
+                five.frames,
+                five.share_over * 100.0,
+                five.threshold_mg
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// A verdict number: integers as such, shares and ratios with three decimals.
+fn num(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e12 {
+        format!("{x:.0}")
+    } else {
+        format!("{x:.3}")
     }
 }

@@ -1,0 +1,454 @@
+//! The per-clip verdict: each quality measure against its cap, and GMR's own `auto_check`
+//! criteria beside ours (definitions and the reasons for each cap in docs/metrics.md).
+
+// Indexing: as in the parent module (the motion is checked against the model first, the
+// per-frame series are as long as the motion).
+#![allow(clippy::indexing_slicing)]
+
+use serde::Serialize;
+
+use super::{scalar_joints, QualityReport};
+use crate::motion::RobotMotion;
+
+/// The caps of [`Verdict`] ([`super::ReportOptions::caps`]). Every time is in seconds and
+/// every share is of frames (or foot × frame samples), so a clip is judged the same at any
+/// rate.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct Caps {
+    /// `floor_skating`: the largest per-foot share of floor frames in which the sole's
+    /// contact point slides ([`super::FootReport::floor_skating_share`]). Default 0.02.
+    pub floor_skating_share: f64,
+    /// `stance`: the least share of source-contact samples with the sole in its band
+    /// ([`super::Stance::sole_in_band_share`]). Default 0.8.
+    pub sole_in_band_share: f64,
+    /// `floating`: the largest share of source-contact samples with the foot floating
+    /// ([`super::Stance::floating_share`]). Default 0.1.
+    pub stance_floating_share: f64,
+    /// `floating`: the longest time both feet may stay above the contact height (s; a
+    /// human flight of 1 s would rise 1.2 m). Default 1.0.
+    pub flight_s: f64,
+    /// `joint_jumps`: the fastest a hinge or slide joint may move between two consecutive
+    /// frames (rad/s or m/s): GMR's severe jump, 1 rad per frame at 30 fps, in seconds.
+    /// Default 30.
+    pub joint_jump_speed: f64,
+    /// `root_acceleration`: the root's mean acceleration over the scaled human's (averaged
+    /// over the dynamics span). Default 1.25.
+    pub root_acceleration_ratio: f64,
+    /// `root_acceleration`: below this mean acceleration (m/s²) nothing is flagged (a
+    /// standing clip's ratio is noise over noise). Default 1.0.
+    pub root_acceleration_floor: f64,
+    /// `root_acceleration` without the human's targets: the largest share of frames over
+    /// 2 g. Default 0.05.
+    pub root_over_2g_share: f64,
+    /// `dynamics`: the largest share of checked frames needing more than the threshold of
+    /// extra wrench ([`super::Dynamics::share_over`]). Default 0.4.
+    pub dynamics_share: f64,
+    /// GMR's `scripts/auto_check.py` criteria.
+    pub gmr: GmrCaps,
+}
+
+impl Default for Caps {
+    fn default() -> Self {
+        Caps {
+            floor_skating_share: 0.02,
+            sole_in_band_share: 0.8,
+            stance_floating_share: 0.1,
+            flight_s: 1.0,
+            joint_jump_speed: 30.0,
+            root_acceleration_ratio: 1.25,
+            root_acceleration_floor: 1.0,
+            root_over_2g_share: 0.05,
+            dynamics_share: 0.4,
+            gmr: GmrCaps::default(),
+        }
+    }
+}
+
+/// GMR's `auto_check.py` thresholds (YanjieZe/GMR `scripts/auto_check.py`).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct GmrCaps {
+    /// Both feet higher than this (m) are off the ground. GMR: 0.12.
+    pub floating_height: f64,
+    /// Floating when both feet are off the ground for this long in one run (s) or for this
+    /// share of the clip in one run. GMR: 1.0 and 0.25.
+    pub floating_s: f64,
+    pub floating_run_share: f64,
+    /// A joint past its range by more than this (rad) in this share of frames. GMR: 0.005
+    /// and 0.05.
+    pub limit_excess: f64,
+    pub limit_share: f64,
+    /// A joint moving more than `jump` (rad) between frames in `jump_share` of the
+    /// transitions, or more than `severe_jump` once. GMR: 0.5, 0.05, 1.0.
+    pub jump: f64,
+    pub jump_share: f64,
+    pub severe_jump: f64,
+    /// Bodies interpenetrating by this much (m) in this share of frames or for this long
+    /// in one run (s). GMR: 0.003, 0.10, 0.6.
+    pub collision_depth: f64,
+    pub collision_share: f64,
+    pub collision_s: f64,
+}
+
+impl Default for GmrCaps {
+    fn default() -> Self {
+        GmrCaps {
+            floating_height: 0.12,
+            floating_s: 1.0,
+            floating_run_share: 0.25,
+            limit_excess: 0.005,
+            limit_share: 0.05,
+            jump: 0.5,
+            jump_share: 0.05,
+            severe_jump: 1.0,
+            collision_depth: 0.003,
+            collision_share: 0.10,
+            collision_s: 0.6,
+        }
+    }
+}
+
+/// One criterion of the verdict.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Check {
+    /// `penetration`, `self_collision`, `floor_skating`, `stance`, `floating`,
+    /// `joint_limits`, `joint_jumps`, `joint_speed`, `root_acceleration`, `dynamics`, and
+    /// GMR's `gmr_floating`, `gmr_joint_limits`, `gmr_joint_jumps`, `gmr_self_collision`.
+    pub name: &'static str,
+    /// `None`: not measured (see `detail`: the file has no source contacts, the model no
+    /// masses, no joint a published speed limit).
+    pub ok: Option<bool>,
+    /// The measured value and the cap it is held to, in `unit`.
+    pub value: f64,
+    pub cap: f64,
+    pub unit: &'static str,
+    /// What was measured, in words.
+    pub detail: String,
+}
+
+/// The verdict of one clip: ok when no check broke its cap.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    pub ok: bool,
+    /// The checks that broke their caps.
+    pub flags: Vec<Check>,
+    /// Every check, in the order above.
+    pub checks: Vec<Check>,
+}
+
+impl Verdict {
+    /// The names of the broken checks.
+    pub fn flag_names(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.flags.iter().map(|c| c.name)
+    }
+}
+
+/// Per-frame series the verdict reads besides the report's summaries.
+pub(super) struct Series<'a> {
+    /// Foot heights above the ground (m), left and right.
+    pub feet: [&'a [f64]; 2],
+    /// Per frame, the deepest self-collision penetration (m, 0 without any).
+    pub self_depth: &'a [f64],
+    /// The report's contact height (m): a foot above it is off the floor.
+    pub contact_height: f64,
+}
+
+/// The longest run of `true` in `mask`.
+fn longest_run(mask: impl Iterator<Item = bool>) -> usize {
+    let (mut best, mut run) = (0, 0);
+    for m in mask {
+        run = if m { run + 1 } else { 0 };
+        best = best.max(run);
+    }
+    best
+}
+
+fn ratio(a: usize, b: usize) -> f64 {
+    super::ratio(a, b)
+}
+
+fn check(name: &'static str, ok: bool, value: f64, cap: f64, unit: &'static str) -> Check {
+    Check { name, ok: Some(ok), value, cap, unit, detail: String::new() }
+}
+
+fn unmeasured(name: &'static str, why: &str) -> Check {
+    Check { name, ok: None, value: 0.0, cap: 0.0, unit: "", detail: why.to_owned() }
+}
+
+/// Per frame transition and joint, `|Δq|` of the hinge and slide joints: the largest per
+/// transition.
+fn joint_steps(motion: &RobotMotion, model: &mjcf::Model) -> Vec<f64> {
+    let adr: Vec<usize> = scalar_joints(model).map(|(_, a)| a).collect();
+    (1..motion.num_frames())
+        .map(|t| {
+            let (a, b) = (motion.frame(t - 1), motion.frame(t));
+            adr.iter().map(|&i| (b[i] - a[i]).abs()).fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// Per frame, the largest excess of a hinge or slide joint past its range (rad or m, 0
+/// inside).
+fn limit_excess(motion: &RobotMotion, model: &mjcf::Model) -> Vec<f64> {
+    let ranges: Vec<(usize, [f64; 2])> =
+        scalar_joints(model).filter_map(|(j, a)| model.joints[j].range.map(|r| (a, r))).collect();
+    (0..motion.num_frames())
+        .map(|t| {
+            let q = motion.frame(t);
+            ranges.iter().map(|&(a, [lo, hi])| (lo - q[a]).max(q[a] - hi)).fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// The verdict of `rep` (the report of `motion` on `model`) under `caps`.
+pub(super) fn verdict(
+    rep: &QualityReport,
+    motion: &RobotMotion,
+    model: &mjcf::Model,
+    series: &Series<'_>,
+    caps: &Caps,
+) -> Verdict {
+    let fps = motion.fps;
+    let frames = motion.num_frames();
+    let steps = joint_steps(motion, model);
+    let excess = limit_excess(motion, model);
+    let mut checks = vec![
+        {
+            let g = &rep.ground_penetration;
+            let mut c = check("penetration", g.frames == 0, g.frames as f64, 0.0, "frames");
+            c.detail = format!(
+                "frames with a collision geom deeper than {:.1} cm below the floor (deepest {:.2} cm)",
+                g.tolerance_cm, g.max_depth_cm
+            );
+            c
+        },
+        {
+            let s = &rep.self_collision;
+            let mut c =
+                check("self_collision", s.frames_deep == 0, s.frames_deep as f64, 0.0, "frames");
+            c.detail = format!(
+                "frames with two of the robot's geoms deeper than {:.1} cm into each other (deepest {:.2} cm)",
+                s.deep_cm, s.max_depth_cm
+            );
+            c
+        },
+        {
+            let worst = rep.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+            let mut c = check(
+                "floor_skating",
+                worst <= caps.floor_skating_share,
+                worst,
+                caps.floor_skating_share,
+                "share",
+            );
+            c.detail = "the worse foot's share of floor frames whose contact point slides".into();
+            c
+        },
+        match &rep.stance {
+            Some(s) => {
+                let mut c = check(
+                    "stance",
+                    s.sole_in_band_share >= caps.sole_in_band_share,
+                    s.sole_in_band_share,
+                    caps.sole_in_band_share,
+                    "share (at least)",
+                );
+                c.detail = "share of source-contact samples with the sole in its band".into();
+                c
+            }
+            None => unmeasured("stance", "no source foot contacts in the motion"),
+        },
+        floating(rep, series, fps, caps),
+        {
+            let v = rep.joint_limits.violations;
+            let mut c = check("joint_limits", v == 0, v as f64, 0.0, "frames × joints");
+            c.detail = format!(
+                "joint samples past their range (largest excess {:.4})",
+                rep.joint_limits.max_excess
+            );
+            c
+        },
+        {
+            let fastest = steps.iter().copied().fold(0.0, f64::max) * fps;
+            let mut c = check(
+                "joint_jumps",
+                fastest <= caps.joint_jump_speed,
+                fastest,
+                caps.joint_jump_speed,
+                "rad/s",
+            );
+            c.detail = "the fastest joint between two consecutive frames".into();
+            c
+        },
+        match &rep.joint_speed {
+            Some(s) => {
+                let mut c = check(
+                    "joint_speed",
+                    s.violations == 0,
+                    s.violations as f64,
+                    0.0,
+                    "frames × joints",
+                );
+                c.detail = format!(
+                    "joint samples over their published speed limit (worst {:.2}× on {})",
+                    s.worst_ratio, s.worst_joint
+                );
+                c
+            }
+            None => unmeasured("joint_speed", "no joint has a published speed limit"),
+        },
+        root_acceleration(rep, caps),
+        match &rep.dynamics {
+            Some(d) => {
+                let mut c = check(
+                    "dynamics",
+                    d.share_over <= caps.dynamics_share,
+                    d.share_over,
+                    caps.dynamics_share,
+                    "share",
+                );
+                c.detail = format!(
+                    "share of frames needing more than {} m·g of wrench the feet cannot supply (accelerations over {:.3} s)",
+                    d.threshold_mg, d.window_s
+                );
+                c
+            }
+            None => unmeasured(
+                "dynamics",
+                rep.dynamics_unavailable.as_deref().unwrap_or("not available"),
+            ),
+        },
+    ];
+    checks.extend(gmr_checks(series, &steps, &excess, fps, frames, &caps.gmr));
+    let flags: Vec<Check> = checks.iter().filter(|c| c.ok == Some(false)).cloned().collect();
+    Verdict { ok: flags.is_empty(), flags, checks }
+}
+
+fn floating(rep: &QualityReport, series: &Series<'_>, fps: f64, caps: &Caps) -> Check {
+    let [l, r] = series.feet;
+    let h = series.contact_height;
+    let flight = longest_run(l.iter().zip(r).map(|(a, b)| a.min(*b) >= h)) as f64 / fps;
+    let stance = rep.stance.as_ref().map_or(0.0, |s| s.floating_share);
+    let ok = flight <= caps.flight_s && stance <= caps.stance_floating_share;
+    // The value is the criterion that broke (or the flight when none did).
+    let (value, cap, unit) = if stance > caps.stance_floating_share {
+        (stance, caps.stance_floating_share, "share")
+    } else {
+        (flight, caps.flight_s, "s")
+    };
+    let mut c = check("floating", ok, value, cap, unit);
+    c.detail = match &rep.stance {
+        Some(_) => format!(
+            "longest time with both feet above {:.0} cm: {flight:.2} s; source-contact samples floating: {:.1} %",
+            h * 100.0,
+            stance * 100.0
+        ),
+        None => format!(
+            "longest time with both feet above {:.0} cm: {flight:.2} s (no source contacts: floating in stance not measured)",
+            h * 100.0
+        ),
+    };
+    c
+}
+
+fn root_acceleration(rep: &QualityReport, caps: &Caps) -> Check {
+    let a = &rep.root_acceleration.averaged;
+    match &a.target {
+        Some(human) => {
+            let ratio = a.motion.mean_mps2 / human.mean_mps2.max(1e-12);
+            let ok = ratio <= caps.root_acceleration_ratio
+                || a.motion.mean_mps2 < caps.root_acceleration_floor;
+            let mut c =
+                check("root_acceleration", ok, ratio, caps.root_acceleration_ratio, "× human");
+            c.detail = format!(
+                "mean root acceleration {:.2} m/s² against the scaled human's {:.2} (over {:.3} s)",
+                a.motion.mean_mps2, human.mean_mps2, a.window_s
+            );
+            c
+        }
+        None => {
+            let share = a.motion.share_over;
+            let mut c = check(
+                "root_acceleration",
+                share <= caps.root_over_2g_share,
+                share,
+                caps.root_over_2g_share,
+                "share",
+            );
+            c.detail = format!(
+                "share of frames with the root accelerating over 2 g (over {:.3} s; no targets, so not against the human)",
+                a.window_s
+            );
+            c
+        }
+    }
+}
+
+/// GMR's `auto_check.py`, on our measures: foot heights are the soles' lowest points (GMR:
+/// the foot body's origin less 3 cm), self-collision is over the report's pairs (GMR: every
+/// contact MuJoCo finds between robot bodies).
+fn gmr_checks(
+    series: &Series<'_>,
+    steps: &[f64],
+    excess: &[f64],
+    fps: f64,
+    frames: usize,
+    g: &GmrCaps,
+) -> Vec<Check> {
+    let [l, r] = series.feet;
+    let off = longest_run(l.iter().zip(r).map(|(a, b)| a.min(*b) > g.floating_height));
+    let (off_s, off_share) = (off as f64 / fps, ratio(off, frames));
+    let mut floating = check(
+        "gmr_floating",
+        off_s < g.floating_s && off_share < g.floating_run_share,
+        off_s,
+        g.floating_s,
+        "s",
+    );
+    floating.detail = format!(
+        "longest run with both feet above {:.0} cm: {off_s:.2} s, {:.1} % of the clip (GMR: ≥ {} s or ≥ {:.0} %)",
+        g.floating_height * 100.0,
+        off_share * 100.0,
+        g.floating_s,
+        g.floating_run_share * 100.0
+    );
+    let past = ratio(excess.iter().filter(|e| **e > g.limit_excess).count(), frames);
+    let mut limits = check("gmr_joint_limits", past < g.limit_share, past, g.limit_share, "share");
+    limits.detail =
+        format!("share of frames with a joint past its range by more than {} rad", g.limit_excess);
+    let jumps = ratio(steps.iter().filter(|s| **s > g.jump).count(), steps.len());
+    let largest = steps.iter().copied().fold(0.0, f64::max);
+    let (value, cap, unit) = if largest >= g.severe_jump {
+        (largest, g.severe_jump, "rad")
+    } else {
+        (jumps, g.jump_share, "share")
+    };
+    let mut jump =
+        check("gmr_joint_jumps", jumps < g.jump_share && largest < g.severe_jump, value, cap, unit);
+    jump.detail = format!(
+        "{:.1} % of transitions with a joint moving more than {} rad, largest {largest:.3} rad (GMR: ≥ {:.0} % or ≥ {} rad once)",
+        jumps * 100.0,
+        g.jump,
+        g.jump_share * 100.0,
+        g.severe_jump
+    );
+    let deep = |d: &f64| *d >= g.collision_depth;
+    let share = ratio(series.self_depth.iter().filter(|d| deep(d)).count(), frames);
+    let run = longest_run(series.self_depth.iter().map(deep)) as f64 / fps;
+    let mut collision = check(
+        "gmr_self_collision",
+        share < g.collision_share && run < g.collision_s,
+        share,
+        g.collision_share,
+        "share",
+    );
+    collision.detail = format!(
+        "{:.1} % of frames with two geoms {:.0} mm or more into each other, longest run {run:.2} s (GMR: ≥ {:.0} % or ≥ {} s)",
+        share * 100.0,
+        g.collision_depth * 1000.0,
+        g.collision_share * 100.0,
+        g.collision_s
+    );
+    vec![floating, limits, jump, collision]
+}
