@@ -912,6 +912,15 @@ fn each_flag_fires_on_a_motion_made_to_break_it() {
     let elbow = model.joints[model.joint_id("left_elbow_joint").unwrap()].qpos_adr;
     jump.qpos[20 * model.nq + elbow] += 1.2;
     assert_eq!(flags(&report(&jump, &model, &opts).unwrap()), ["joint_jumps", "gmr_joint_jumps"]);
+    // Every joint with a published speed limit (10 rad/s): held to it, not to the jump cap.
+    let mut limited = model.clone();
+    for j in &mut limited.joints {
+        j.velocity_limit = Some(10.0);
+    }
+    let rep = report(&jump, &limited, &opts).unwrap();
+    assert_eq!(flags(&rep), ["joint_speed", "gmr_joint_jumps"]);
+    let jumps = rep.verdict.checks.iter().find(|c| c.name == "joint_jumps").unwrap();
+    assert!(jumps.ok.is_none() && jumps.detail.contains("published speed limit"), "{jumps:?}");
     // The root shaken sideways at 3 g while the scaled human's pelvis stands still.
     let stand = standing_height(&model, 0.001);
     let mut shaken = root_motion(

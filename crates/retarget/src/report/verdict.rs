@@ -28,8 +28,9 @@ pub struct Caps {
     /// `floating`: the longest time both feet may stay above the contact height (s; a
     /// human flight of 1 s would rise 1.2 m). Default 1.0.
     pub flight_s: f64,
-    /// `joint_jumps`: the fastest a hinge or slide joint may move between two consecutive
-    /// frames (rad/s or m/s): GMR's severe jump, 1 rad per frame at 30 fps, in seconds.
+    /// `joint_jumps`: the fastest a hinge or slide joint without a published speed limit may
+    /// move between two consecutive frames (rad/s or m/s): GMR's severe jump, 1 rad per frame
+    /// at 30 fps, in seconds. Joints with a published limit are held to it (`joint_speed`).
     /// Default 30.
     pub joint_jump_speed: f64,
     /// `root_acceleration`: the root's mean acceleration over the scaled human's (averaged
@@ -176,10 +177,13 @@ fn unmeasured(name: &'static str, why: &str) -> Check {
     Check { name, ok: None, value: 0.0, cap: 0.0, unit: "", detail: why.to_owned() }
 }
 
-/// Per frame transition and joint, `|Δq|` of the hinge and slide joints: the largest per
-/// transition.
-fn joint_steps(motion: &RobotMotion, model: &mjcf::Model) -> Vec<f64> {
-    let adr: Vec<usize> = scalar_joints(model).map(|(_, a)| a).collect();
+/// Per frame transition, the largest `|Δq|` of the hinge and slide joints, of those without
+/// a published speed limit when `unlimited`.
+fn joint_steps(motion: &RobotMotion, model: &mjcf::Model, unlimited: bool) -> Vec<f64> {
+    let adr: Vec<usize> = scalar_joints(model)
+        .filter(|&(j, _)| !unlimited || model.joints[j].velocity_limit.is_none_or(|l| l <= 0.0))
+        .map(|(_, a)| a)
+        .collect();
     (1..motion.num_frames())
         .map(|t| {
             let (a, b) = (motion.frame(t - 1), motion.frame(t));
@@ -211,7 +215,10 @@ pub(super) fn verdict(
 ) -> Verdict {
     let fps = motion.fps;
     let frames = motion.num_frames();
-    let steps = joint_steps(motion, model);
+    let steps = joint_steps(motion, model, false);
+    let unlimited = joint_steps(motion, model, true);
+    let any_unlimited =
+        scalar_joints(model).any(|(j, _)| model.joints[j].velocity_limit.is_none_or(|l| l <= 0.0));
     let excess = limit_excess(motion, model);
     let mut checks = vec![
         {
@@ -269,8 +276,8 @@ pub(super) fn verdict(
             );
             c
         },
-        {
-            let fastest = steps.iter().copied().fold(0.0, f64::max) * fps;
+        if any_unlimited {
+            let fastest = unlimited.iter().copied().fold(0.0, f64::max) * fps;
             let mut c = check(
                 "joint_jumps",
                 fastest <= caps.joint_jump_speed,
@@ -278,8 +285,12 @@ pub(super) fn verdict(
                 caps.joint_jump_speed,
                 "rad/s",
             );
-            c.detail = "the fastest joint between two consecutive frames".into();
+            c.detail =
+                "the fastest joint without a published speed limit between two consecutive frames"
+                    .into();
             c
+        } else {
+            unmeasured("joint_jumps", "every joint has a published speed limit (see joint_speed)")
         },
         match &rep.joint_speed {
             Some(s) => {
