@@ -150,6 +150,13 @@ impl<'a> Prepared<'a> {
         }
     }
 
+    /// The frames in `seconds` at the clip's rate, rounded (30 fps for a clip without one, as
+    /// the windows take it): the one conversion of the solve's times into frames.
+    pub(super) fn frames_in(&self, seconds: f64) -> usize {
+        let fps = if self.fps > 0.0 { self.fps } else { 30.0 };
+        (seconds * fps).round().max(0.0) as usize
+    }
+
     pub(super) fn frame_targets(&self, f: usize) -> &[Pose] {
         &self.targets[f * self.slots..(f + 1) * self.slots]
     }

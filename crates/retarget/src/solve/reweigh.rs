@@ -51,7 +51,7 @@ impl<'a> Prepared<'a> {
 
     /// How far (m) the robot's pelvis stands above or below its target with the config's
     /// weights: the median height difference over [`PELVIS_WINDOWS`] windows of
-    /// [`PELVIS_WINDOW`] frames (at a quarter, half and three quarters of the clip, or the
+    /// [`PELVIS_WINDOW_S`] (at a quarter, half and three quarters of the clip, or the
     /// whole of a shorter clip), each solved from its first frame as a clip is, its first
     /// frames left out. Height only: the horizontal offsets follow the direction of travel
     /// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). `None` when no task
@@ -64,22 +64,24 @@ impl<'a> Prepared<'a> {
             .find(|t| t.target == self.root_target && t.pos_weight > 0.0);
         let Some(body) = root.map(|t| t.body) else { return Ok(None) };
         let frames = self.num_frames();
-        let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * PELVIS_WINDOW {
+        let (window_frames, settle) =
+            (self.frames_in(PELVIS_WINDOW_S).max(1), self.frames_in(PELVIS_SETTLE_S));
+        let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * window_frames {
             std::iter::once(0..frames).collect()
         } else {
             (1..=PELVIS_WINDOWS)
                 .map(|k| {
-                    let start = frames * k / (PELVIS_WINDOWS + 1) - PELVIS_WINDOW / 2;
-                    start..start + PELVIS_WINDOW
+                    let start = frames * k / (PELVIS_WINDOWS + 1) - window_frames / 2;
+                    start..start + window_frames
                 })
                 .collect()
         };
         let mut solver = self.solver()?;
-        let mut heights = Vec::with_capacity(PELVIS_WINDOWS * PELVIS_WINDOW);
+        let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
         for window in windows {
             for f in window.clone() {
                 self.first_pass_frame(&mut solver, f, f == window.start)?;
-                if f >= window.start + PELVIS_SETTLE || window.len() <= PELVIS_SETTLE {
+                if f >= window.start + settle || window.len() <= settle {
                     let target = &self.frame_targets(f)[self.root_target];
                     heights.push(solver.data().xpos[body].z - target.pos.z);
                 }
@@ -113,11 +115,11 @@ fn report(offset: f64, share: f64) -> StageReport {
 }
 
 /// Windows of a clip solved to measure how far the pelvis stands from its target
-/// ([`Prepared::pelvis_offset`]), their length in frames, and the frames at the start of each
-/// left out (the solve settles from its start pose).
+/// ([`Prepared::pelvis_offset`]), their length (s), and the time at the start of each left
+/// out (s; the solve settles from its start pose). 30 and 5 frames at 30 fps.
 const PELVIS_WINDOWS: usize = 3;
-const PELVIS_WINDOW: usize = 30;
-const PELVIS_SETTLE: usize = 5;
+const PELVIS_WINDOW_S: f64 = 1.0;
+const PELVIS_SETTLE_S: f64 = 1.0 / 6.0;
 
 /// The default solve's weights where the config pins the pelvis at a height that disagrees
 /// with the robot's legs:

@@ -20,10 +20,11 @@ use crate::Error;
 /// feet were up to 10 cm off.
 pub const UNCROSS_STUCK: f64 = 0.03;
 
-/// Frames solved again either side of the frames whose targets an uncrossing changed
-/// (`Prepared::resolve_uncrossed`), and the lead-in before them (as a chunk's).
-pub const RESOLVE_MARGIN: usize = 30;
-pub const RESOLVE_LEAD_IN: usize = 60;
+/// Time (s) solved again either side of the frames whose targets an uncrossing changed
+/// (`Prepared::resolve_uncrossed`), and the lead-in before them (as a chunk's): 30 and 60
+/// frames at 30 fps.
+pub const RESOLVE_MARGIN_S: f64 = 1.0;
+pub const RESOLVE_LEAD_IN_S: f64 = 2.0;
 
 /// The two legs touch where geoms of theirs are closer than this (m)
 /// ([`PlausibleOptions::uncross_stuck`](super::PlausibleOptions::uncross_stuck)).
@@ -41,7 +42,7 @@ impl<'a> Prepared<'a> {
     /// [`PlausibleOptions::uncross_stuck`](super::PlausibleOptions::uncross_stuck) on the whole clip's solved frames (`solved`): plans
     /// the feet again with the stuck crossed stances uncrossed ([`Prepared::uncross_stuck`])
     /// and solves again the frames whose targets that changed, with
-    /// [`RESOLVE_MARGIN`] frames either side and a lead-in of [`RESOLVE_LEAD_IN`], as a chunk
+    /// [`RESOLVE_MARGIN_S`] either side and a lead-in of [`RESOLVE_LEAD_IN_S`], as a chunk
     /// is solved ([`crate::chunked`]); the rest of the clip is kept.
     pub(crate) fn resolve_uncrossed(&mut self, solved: &mut Solved) -> Result<(), Error> {
         let Some(changed) = self.uncross_stuck(&solved.qpos, &solved.frames) else {
@@ -49,9 +50,9 @@ impl<'a> Prepared<'a> {
         };
         let nq = self.model.nq;
         let n = solved.frames.len();
-        let range =
-            changed.start.saturating_sub(RESOLVE_MARGIN)..(changed.end + RESOLVE_MARGIN).min(n);
-        let mut part = super::solve_range(self, range.clone(), RESOLVE_LEAD_IN)?;
+        let margin = self.frames_in(RESOLVE_MARGIN_S);
+        let range = changed.start.saturating_sub(margin)..(changed.end + margin).min(n);
+        let mut part = super::solve_range(self, range.clone(), self.frames_in(RESOLVE_LEAD_IN_S))?;
         if let Some(before) = range.start.checked_sub(1) {
             super::schedule::continue_quaternions(
                 self.model,
