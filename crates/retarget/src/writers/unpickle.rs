@@ -424,7 +424,7 @@ impl<'a> Vm<'a> {
     }
 
     fn extend_dict(&mut self, items: Vec<Id>) -> Result<(), UnpickleError> {
-        if items.len() % 2 != 0 {
+        if !items.len().is_multiple_of(2) {
             return self.fail("SETITEMS with a key and no value");
         }
         let dict = self.top()?;
@@ -645,7 +645,7 @@ impl Pickle<'_> {
 
     /// A numpy array as (shape, values in C order), converted to `f64`.
     pub(crate) fn array(&self, id: Id) -> Result<(Vec<usize>, Vec<f64>), String> {
-        let (shape, dtype, raw, fortran) = match self.get(id) {
+        let RawArray { shape, dtype, raw, fortran } = match self.get(id) {
             Some(Node::Array { state: Some(state) }) => self.array_state(*state)?,
             Some(Node::Array { state: None }) => return Err("an array never built".to_owned()),
             Some(&Node::Buffer { buffer, dtype, shape, order }) => {
@@ -657,7 +657,12 @@ impl Pickle<'_> {
                     Some("F") => true,
                     _ => return Err("_frombuffer's order is neither 'C' nor 'F'".to_owned()),
                 };
-                (self.shape(shape)?, self.dtype(dtype)?, raw.as_ref(), fortran)
+                RawArray {
+                    shape: self.shape(shape)?,
+                    dtype: self.dtype(dtype)?,
+                    raw: raw.as_ref(),
+                    fortran,
+                }
             }
             Some(other) => return Err(format!("{} is not a numpy array", describe(other))),
             None => return Err("a dangling reference".to_owned()),
@@ -677,7 +682,7 @@ impl Pickle<'_> {
 
     /// numpy's `__setstate__` tuple: `(version, shape, dtype, is_fortran, raw)` (or without the
     /// version, as numpy before 1.0 wrote it).
-    fn array_state(&self, state: Id) -> Result<(Vec<usize>, Dtype, &[u8], bool), String> {
+    fn array_state(&self, state: Id) -> Result<RawArray<'_>, String> {
         let items = match self.get(state) {
             Some(Node::Tuple(items)) => items.as_slice(),
             _ => return Err("an array state that is not a tuple".to_owned()),
@@ -696,8 +701,21 @@ impl Pickle<'_> {
         let Some(Node::Bytes(raw)) = self.get(raw) else {
             return Err("an array whose data is not bytes (object arrays are not read)".to_owned());
         };
-        Ok((self.shape(shape)?, self.dtype(dtype)?, raw.as_ref(), fortran))
+        Ok(RawArray {
+            shape: self.shape(shape)?,
+            dtype: self.dtype(dtype)?,
+            raw: raw.as_ref(),
+            fortran,
+        })
     }
+}
+
+/// An array's description and bytes, before conversion.
+struct RawArray<'p> {
+    shape: Vec<usize>,
+    dtype: Dtype,
+    raw: &'p [u8],
+    fortran: bool,
 }
 
 /// Fortran-order `values` of `shape` in C order (the first index varies fastest in the
@@ -798,6 +816,7 @@ mod tests {
         let values: Vec<f64> = (0..24).map(f64::from).collect();
         let c = c_order(&[2, 3, 4], &values);
         // Element (i, j, k) is at i + 2j + 6k in Fortran order.
-        assert_eq!(c[(1 * 3 + 2) * 4 + 3], f64::from(1 + 2 * 2 + 6 * 3));
+        let (i, j, k) = (1, 2, 3);
+        assert_eq!(c[(i * 3 + j) * 4 + k], (i + 2 * j + 6 * k) as f64);
     }
 }
