@@ -1,5 +1,7 @@
-//! `retarget report MOTION.npz`: quality metrics of a retargeted motion (see
-//! `retarget::report` for the definitions), as a table and optionally as JSON.
+//! `retarget report MOTION`: quality metrics of a robot motion (see `retarget::report` for
+//! the definitions), as a table and optionally as JSON. The motion is ours (.npz) or another
+//! tool's (`retarget::writers::read_motion`: an .npz of qpos, BeyondMimic's .npz, GMR's .pkl,
+//! Unitree's .csv).
 
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -7,17 +9,27 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use retarget::report::{report, ReportOptions};
-use retarget::writers::{read_motion_npz, read_npz_robot};
+use retarget::writers::{read_motion, read_motion_npz, read_npz_robot, FpsFrom};
 
 use crate::shipped;
 
 #[derive(clap::Args, Debug)]
 pub struct ReportArgs {
-    /// A motion written by `retarget` (.npz).
+    /// A robot motion: retarget's .npz; an .npz of `qpos` (T×nq, MuJoCo's layout, e.g.
+    /// GMR's) with or without `fps`; BeyondMimic's / mjlab's .npz (`joint_pos`,
+    /// `body_pos_w`, `body_quat_w`, `fps`; the root is body 0); GMR's .pkl (read without
+    /// executing it); Unitree's .csv (`x,y,z,qx,qy,qz,qw,joints…` per line, needs --fps).
+    /// Only retarget's .npz stores targets and source foot contacts: without them tracking,
+    /// skating and stance are not measured.
     pub motion: PathBuf,
-    /// Robot (shipped name or MJCF path); default: the `robot` name stored in the .npz.
+    /// Robot (shipped name or MJCF path); default: the `robot` name stored in the .npz
+    /// (required for files that store none: .pkl, .csv and most other tools' .npz).
     #[arg(long)]
     pub robot: Option<String>,
+    /// Frame rate of a motion that stores none (a .csv, an .npz without `fps`). A value that
+    /// disagrees with the file's stored fps is an error (the file's timing is measured).
+    #[arg(long)]
+    pub fps: Option<f64>,
     /// The IK config the motion was solved with: bodies without a position weight get no
     /// position error, and its `robot_root_name`'s target is the scaled human's pelvis.
     /// Default: the shipped config of a shipped robot (else every target body's position is
@@ -59,15 +71,11 @@ pub struct ReportArgs {
 }
 
 pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
-    let mut motion = read_motion_npz(&args.motion)?;
-    if let Some(other) = &args.targets_from {
-        motion.targets = Some(targets_of(other, &motion)?);
-    }
     let (model, robot_arg) = match &args.robot {
         Some(robot) => (shipped::robot_model(robot)?, robot.clone()),
         None => {
-            let stored = read_npz_robot(&args.motion)?.with_context(|| {
-                format!("{}: no robot name stored; pass --robot", args.motion.display())
+            let stored = stored_robot(&args.motion)?.with_context(|| {
+                format!("{}: no robot name stored in the file; pass --robot", args.motion.display())
             })?;
             let model = shipped::robot_model(&stored).with_context(|| {
                 format!("{}: stored robot \"{stored}\"; pass --robot", args.motion.display())
@@ -75,6 +83,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
             (model, stored)
         }
     };
+    let (mut motion, source) = read_motion(&args.motion, &model, args.fps)?;
+    if let Some(other) = &args.targets_from {
+        motion.targets = Some(targets_of(other, &motion)?);
+    }
     let config = match &args.config {
         Some(path) => Some(retarget::IkConfig::from_file(path)?),
         None => crate::cmd_retarget::shipped_config(&robot_arg).transpose()?,
@@ -114,6 +126,7 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         crate::atomic_write(path, text.as_bytes())?;
     }
     let mut text = rep.to_string();
+    text.push_str(&input_note(&source, &motion, args.targets_from.is_some()));
     if let Ok(roles) = retarget::RobotRoles::recognise(&model) {
         for blocked in retarget::blocked_limbs(&model, &roles, &motion) {
             text.push_str(&format!("cannot follow: {blocked}\n"));
@@ -123,6 +136,42 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(ExitCode::SUCCESS),
     }
+}
+
+/// The robot name an .npz stores (`robot`); none for other files.
+fn stored_robot(path: &std::path::Path) -> anyhow::Result<Option<String>> {
+    let mut head = [0u8; 2];
+    let is_zip = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .is_ok_and(|()| head == *b"PK");
+    Ok(if is_zip { read_npz_robot(path)? } else { None })
+}
+
+/// What the report read, and what it could not measure for want of targets or contacts.
+fn input_note(
+    source: &retarget::writers::MotionSource,
+    motion: &retarget::RobotMotion,
+    targets_from: bool,
+) -> String {
+    let fps = match source.fps_from {
+        FpsFrom::File => "fps from the file",
+        FpsFrom::Caller => "fps from --fps",
+    };
+    let mut note = format!("\ninput: {} ({fps})\n", source.format.describe());
+    let mut missing = Vec::new();
+    if motion.targets.is_none() && !targets_from {
+        missing.push(
+            "tracking error: the file has no targets (--targets-from takes them from a motion \
+             of the same clip)",
+        );
+    }
+    if motion.contacts.is_none() {
+        missing.push("skating and stance: the file has no source foot contacts");
+    }
+    for m in missing {
+        note.push_str(&format!("not measured: {m}\n"));
+    }
+    note
 }
 
 /// The targets stored in `other`, checked to be of the same clip as `motion`: same frame

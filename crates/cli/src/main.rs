@@ -68,7 +68,8 @@ enum Command {
     Robot(cmd_robot::RobotCommand),
     /// Convert a whole directory tree of clips, in parallel and resumable.
     Batch(cmd_batch::BatchArgs),
-    /// Quality metrics of a retargeted motion (.npz): tracking, limits, jitter, foot contact.
+    /// Quality metrics of a robot motion (ours or .npz / .pkl / .csv of GMR, BeyondMimic,
+    /// Unitree): tracking, limits, jitter, foot contact.
     Report(cmd_report::ReportArgs),
     /// Write a self-contained HTML player (WebGL) with plots for a robot motion or a BVH.
     View(cmd_view::ViewArgs),

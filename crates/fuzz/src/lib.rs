@@ -23,6 +23,7 @@
 pub mod amass;
 pub mod fbx_target;
 pub mod guard;
+pub mod motions;
 mod mutate;
 mod seeds;
 pub mod targets;

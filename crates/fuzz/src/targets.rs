@@ -1,7 +1,8 @@
 //! The fuzz targets: one per parser, each running the stages that follow a successful parse
 //! (BVH → FK and role recognition; C3D → markers; MJCF/URDF → kinematics; IK config →
-//! validation and targets against the G1; npz → the quality report on the G1; FBX → takes,
-//! BVH and FK, in `fbx_target`).
+//! validation and targets against the G1; npz (ours, qpos only, BeyondMimic's) → the quality
+//! report on the G1; FBX → takes, BVH and FK, in `fbx_target`; GMR's pickle and Unitree's
+//! CSV → the report, in `motions`).
 
 use std::fmt::Write as _;
 use std::io::Cursor;
@@ -24,6 +25,8 @@ pub fn all() -> Vec<Box<dyn Target>> {
         Box::new(NpzTarget),
         Box::new(crate::fbx_target::FbxTarget),
         Box::new(crate::amass::AmassTarget),
+        Box::new(crate::motions::PickleTarget),
+        Box::new(crate::motions::CsvTarget),
     ]
 }
 
@@ -38,7 +41,7 @@ fn text(input: &[u8]) -> std::result::Result<&str, String> {
 }
 
 /// The shipped G1, the robot of the config and npz targets.
-fn g1() -> &'static mjcf::Model {
+pub(crate) fn g1() -> &'static mjcf::Model {
     static G1: OnceLock<mjcf::Model> = OnceLock::new();
     G1.get_or_init(|| {
         let xml = include_str!("../../../robots/unitree_g1/unitree_g1.xml");
@@ -49,7 +52,7 @@ fn g1() -> &'static mjcf::Model {
 /// Numbers as a generator writes them: mostly ordinary, sometimes extreme or malformed
 /// (1 in 40), so that most generated files get past the tokenizer.
 #[derive(Debug, Clone, Copy)]
-enum Num {
+pub(crate) enum Num {
     Small(i8),
     Tenths(i16),
     Any(f64),
@@ -70,7 +73,7 @@ impl<'a> Arbitrary<'a> for Num {
 impl Num {
     /// Writes the number; unless `wild`, extreme and malformed ones are written as `0` or a
     /// finite value (a generated file is either clean, to reach the later stages, or wild).
-    fn write(self, out: &mut String, wild: bool) {
+    pub(crate) fn write(self, out: &mut String, wild: bool) {
         const SPECIAL: &[&str] =
             &["nan", "inf", "-inf", "1e300", "-1e300", "1e-320", "0", "-0", "1e999", "", "+", "."];
         let _ = match self {
@@ -320,7 +323,7 @@ const LABELS: &[&str] = &[
     "RTOE", "C7", "T10", "CLAV", "STRN", "LSHO", "LELB", "LWRA", "LFIN", "RFHD", "",
 ];
 
-fn num_value(n: Num) -> f64 {
+pub(crate) fn num_value(n: Num) -> f64 {
     match n {
         Num::Small(v) => f64::from(v),
         Num::Tenths(v) => f64::from(v) / 10.0,
@@ -1023,6 +1026,46 @@ impl NpzTarget {
                 strings(&bodies),
             ),
         ];
+        // Other tools' layouts (`read_motion`): qpos without names, or BeyondMimic's keys.
+        match u.int_in_range(0..=3)? {
+            2 => members.retain(|(n, _, _)| n != "joint_names.npy" && n != "body_names.npy"),
+            3 => {
+                let keep_names: bool = u.arbitrary()?;
+                members.retain(|(n, _, _)| {
+                    n != "qpos.npy"
+                        && n != "body_names.npy"
+                        && (keep_names || n != "joint_names.npy")
+                });
+                let b = u.int_in_range(1..=4)?;
+                let joints = nq - 7;
+                let base = model.qpos0.get(7..).unwrap_or_default();
+                let shape = |dims: &[usize]| {
+                    format!(
+                        "({})",
+                        dims.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+                    )
+                };
+                members.push(member(
+                    "joint_pos",
+                    "<f8".to_owned(),
+                    &shape(&[frames, joints]),
+                    floats(u, frames * joints, base)?,
+                ));
+                members.push(member(
+                    "body_pos_w",
+                    "<f8".to_owned(),
+                    &shape(&[frames, b, 3]),
+                    floats(u, frames * b * 3, &[0.0, 0.0, 0.79])?,
+                ));
+                members.push(member(
+                    "body_quat_w",
+                    "<f8".to_owned(),
+                    &shape(&[frames, b, 4]),
+                    floats(u, frames * b * 4, &[1.0, 0.0, 0.0, 0.0])?,
+                ));
+            }
+            _ => {}
+        }
         if u.arbitrary()? {
             let bools: Vec<u8> =
                 (0..frames).map(|_| u.arbitrary::<bool>().map(u8::from)).collect::<Result<_>>()?;
@@ -1092,7 +1135,7 @@ impl NpzTarget {
 #[rustfmt::skip]
 const NPZ_KEYS: &[&str] = &[
     "fps", "qpos", "joint_names", "body_names", "target_body_names", "target_pos", "target_quat",
-    "contact_left", "contact_right", "robot", "joint_pos",
+    "contact_left", "contact_right", "robot", "joint_pos", "body_pos_w", "body_quat_w",
 ];
 
 impl Target for NpzTarget {
@@ -1127,10 +1170,11 @@ impl Target for NpzTarget {
     }
 
     fn run(&self, input: &[u8]) -> std::result::Result<(), String> {
-        let motion =
-            retarget::writers::read_motion_npz_bytes(input, std::path::Path::new("fuzz.npz"))
-                .map_err(|e| e.to_string())?;
-        let _ = motion.num_frames();
+        let name = std::path::Path::new("fuzz.npz");
+        // Our own reader, then the reader of every .npz layout, whose motion is reported.
+        let _ = retarget::writers::read_motion_npz_bytes(input, name).map(|m| m.num_frames());
+        let (motion, _) = retarget::writers::read_motion_bytes(input, name, g1(), None)
+            .map_err(|e| e.to_string())?;
         let report =
             retarget::report::report(&motion, g1(), &retarget::report::ReportOptions::default())
                 .map_err(|e| e.to_string())?;

@@ -14,7 +14,10 @@ fn every_parser_survives_a_short_fuzz_pass() {
     replay_regressions();
     let targets = fuzz::targets::all();
     let names: Vec<&str> = targets.iter().map(|t| t.name()).collect();
-    assert_eq!(names, ["bvh", "c3d", "mjcf", "urdf", "config", "npz", "fbx", "amass"]);
+    assert_eq!(
+        names,
+        ["bvh", "c3d", "mjcf", "urdf", "config", "npz", "fbx", "amass", "pickle", "csv"]
+    );
     for target in targets {
         let options = fuzz::Options {
             executions: EXECUTIONS,

@@ -8,7 +8,9 @@ use std::process::Command;
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use retarget::writers::{read_motion_npz, read_npz_robot, write_motion, Format};
+use retarget::writers::{
+    read_motion, read_motion_npz, read_npz_robot, write_motion, Format, FpsFrom, MotionFormat,
+};
 use retarget::{Error, RobotMotion, TrackedTargets};
 use serde_json::Value;
 
@@ -92,6 +94,33 @@ fn npz_round_trip_is_exact() {
     assert_eq!(read_motion_npz(&path).unwrap(), without_targets);
     // Only the final file: no temporary left behind.
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+}
+
+/// Every format we write is read back by `read_motion` (the report's reader): our `.npz` whole
+/// (targets included), `.pkl` and `.csv` as their `qpos` (exact: the root is stored as given,
+/// numbers round-trip).
+#[test]
+fn read_motion_reads_every_format_we_write() {
+    let Some(model) = g1() else { return };
+    let motion = smooth_motion(&model, 3);
+    let dir = scratch_dir("read_motion");
+    for (ext, format, fps) in [
+        ("npz", MotionFormat::Npz, FpsFrom::File),
+        ("pkl", MotionFormat::GmrPickle, FpsFrom::File),
+        ("csv", MotionFormat::UnitreeCsv, FpsFrom::Caller),
+    ] {
+        let path = dir.join(format!("walk.{ext}"));
+        write_motion(&path, &motion, &model, None).unwrap();
+        let (back, source) = read_motion(&path, &model, Some(FPS)).unwrap();
+        assert_eq!((source.format, source.fps_from), (format, fps), "{ext}");
+        assert_eq!(back.qpos, motion.qpos, "{ext}");
+        if ext == "npz" {
+            assert_eq!(back, read_motion_npz(&path).unwrap());
+            assert_eq!(back, motion);
+        } else {
+            assert_eq!(back.targets, None);
+        }
+    }
 }
 
 #[test]

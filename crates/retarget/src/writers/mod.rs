@@ -1,5 +1,7 @@
 //! Output writers: a [`RobotMotion`] to `.npz` (numpy, the default), Unitree's `.csv`, GMR's
-//! `.pkl` and a human-readable `.json`, and back from our `.npz`.
+//! `.pkl` and a human-readable `.json`; and readers, for the report: our `.npz`
+//! ([`read_motion_npz`]) and other tools' motions ([`read_motion`]: `.npz` of `qpos`,
+//! BeyondMimic's `.npz`, GMR's `.pkl`, Unitree's `.csv`).
 //!
 //! Every file is in the world frame of the pipeline: Z up, metres, radians. Quaternions are
 //! w-first in our own files (`.npz`, `.json`); the two formats that define x y z w (the
@@ -18,6 +20,8 @@ mod json;
 pub mod npy;
 mod npz;
 mod pickle;
+mod read;
+mod unpickle;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -29,6 +33,7 @@ use crate::Error;
 
 pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
+pub use read::{read_motion, read_motion_bytes, FpsFrom, MotionFormat, MotionSource};
 
 /// Output formats, chosen by file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -140,6 +145,14 @@ pub(crate) const fn xyzw_from_wxyz(wxyz: [f64; 4]) -> [f64; 4] {
     [wxyz[1], wxyz[2], wxyz[3], wxyz[0]]
 }
 
+/// The w x y z (scalar-first) order of an x y z w quaternion read from Unitree's CSV or
+/// GMR's `root_rot`: [`xyzw_from_wxyz`]'s inverse, the only place where read files change
+/// quaternion order.
+#[must_use]
+pub(crate) const fn wxyz_from_xyzw(xyzw: [f64; 4]) -> [f64; 4] {
+    [xyzw[3], xyzw[0], xyzw[1], xyzw[2]]
+}
+
 /// Checks that `motion` is one of `model`'s and holds only finite numbers.
 pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<(), Error> {
     if motion.nq != model.nq {
@@ -249,6 +262,7 @@ mod tests {
     #[test]
     fn xyzw_moves_w_last() {
         assert_eq!(xyzw_from_wxyz([1.0, 2.0, 3.0, 4.0]), [2.0, 3.0, 4.0, 1.0]);
+        assert_eq!(wxyz_from_xyzw(xyzw_from_wxyz([1.0, 2.0, 3.0, 4.0])), [1.0, 2.0, 3.0, 4.0]);
     }
 
     #[test]

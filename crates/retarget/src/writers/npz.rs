@@ -98,7 +98,7 @@ fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
 }
 
 /// [`read_npz`] on any reader; `path` names it in errors.
-fn read_npz_from<R: Read + Seek>(
+pub(super) fn read_npz_from<R: Read + Seek>(
     mut reader: R,
     path: &Path,
 ) -> Result<BTreeMap<String, Array>, Error> {
@@ -194,7 +194,7 @@ pub fn read_npz_robot(path: &Path) -> Result<Option<String>, Error> {
     Ok(arrays.get("robot").and_then(strings).and_then(|s| s.first().cloned()))
 }
 
-fn read_targets(
+pub(super) fn read_targets(
     names: &Array,
     pos: &Array,
     quat: &Array,
@@ -229,7 +229,11 @@ fn read_targets(
     Ok(TrackedTargets { body_names: names.to_vec(), pos, quat })
 }
 
-fn read_contacts(left: &Array, right: &Array, frames: usize) -> Result<FootContacts, String> {
+pub(super) fn read_contacts(
+    left: &Array,
+    right: &Array,
+    frames: usize,
+) -> Result<FootContacts, String> {
     let side = |a: &Array, key: &str| match &a.data {
         ArrayData::Bool(v) if a.shape == [frames] => Ok(v.clone()),
         _ => Err(format!("`{key}` is not a bool array of {frames} frames")),
@@ -237,14 +241,14 @@ fn read_contacts(left: &Array, right: &Array, frames: usize) -> Result<FootConta
     Ok(FootContacts { left: side(left, "contact_left")?, right: side(right, "contact_right")? })
 }
 
-fn floats(a: &Array) -> Option<&[f64]> {
+pub(super) fn floats(a: &Array) -> Option<&[f64]> {
     match &a.data {
         ArrayData::F64(v) => Some(v),
         ArrayData::Str(_) | ArrayData::Bool(_) => None,
     }
 }
 
-fn strings(a: &Array) -> Option<&[String]> {
+pub(super) fn strings(a: &Array) -> Option<&[String]> {
     match &a.data {
         ArrayData::Str(v) => Some(v),
         ArrayData::F64(_) | ArrayData::Bool(_) => None,
