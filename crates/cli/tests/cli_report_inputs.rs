@@ -90,6 +90,19 @@ fn gmrs_walk_reports_the_same_as_qpos_npz_pickle_and_csv() {
     assert_eq!(from_npz["frames"], 7184, "{from_npz}");
     assert_eq!(from_npz, from_pkl);
     assert_eq!(from_npz, from_csv);
+    // Issue 39: GMR's walk is flagged for self-collision (its hands through its hips in 1,815
+    // frames), by our cap and by GMR's own auto_check criterion.
+    let flags: Vec<&str> = from_npz["verdict"]["flags"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["name"].as_str().unwrap())
+        .collect();
+    assert!(
+        flags.contains(&"self_collision") && flags.contains(&"gmr_self_collision"),
+        "{flags:?}"
+    );
+    assert_eq!(from_npz["self_collision"]["frames_deep"], 1815);
     // No targets or contacts in these files: said, not measured.
     let (stdout, _) =
         text(&retarget(&["report", csv.to_str().unwrap(), "--robot", "unitree_g1", "--fps", "30"]));
@@ -99,6 +112,32 @@ fn gmrs_walk_reports_the_same_as_qpos_npz_pickle_and_csv() {
         stdout.contains("not measured: skating and stance: the file has no source foot contacts"),
         "{stdout}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Issue 39: the default solve's walk, the clip of GMR's above, keeps every cap.
+#[test]
+fn our_default_walk_is_not_flagged() {
+    let Some(bvh) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let dir = temp_dir("default_walk");
+    let npz = dir.join("walk.npz");
+    let out = retarget(&[
+        "--bvh",
+        bvh.to_str().unwrap(),
+        "--robot",
+        "unitree_g1",
+        "--human-height",
+        "1.75",
+        "-o",
+        npz.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rep = report_json(&npz, &dir.join("walk.json"), &[]);
+    assert_eq!(rep["verdict"]["ok"], true, "{}", rep["verdict"]);
+    let (stdout, _) = text(&retarget(&["report", npz.to_str().unwrap()]));
+    assert!(stdout.starts_with("verdict: ok ("), "{stdout}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -135,7 +174,7 @@ fn pythons_own_pickles_are_reported() {
         let out = retarget(&["report", fixture(name).to_str().unwrap(), "--robot", "unitree_g1"]);
         let (stdout, stderr) = text(&out);
         assert!(out.status.success(), "{name}: {stderr}");
-        assert!(stdout.starts_with("robot unitree_g1 · 3 frames at 30 fps"), "{stdout}");
+        assert!(stdout.contains("\nrobot unitree_g1 · 3 frames at 30 fps"), "{stdout}");
         assert!(stdout.contains("input: GMR pickle (fps from the file)"), "{stdout}");
     }
 }

@@ -14,9 +14,7 @@ impl fmt::Display for QualityReport {
             "robot {} · {} frames at {} fps ({secs:.2} s)",
             self.robot, self.frames, self.fps
         )?;
-        if self.tracking.is_none() {
-            writeln!(f, "tracking: - (no targets in the motion: tracking error not measured)")?;
-        }
+
         if let Some(tracking) = &self.tracking {
             writeln!(f, "\ntracking error           position (cm) mean / p95 / max   rotation (rad) mean / p95 / max")?;
             for b in tracking {
