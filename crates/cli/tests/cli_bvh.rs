@@ -162,6 +162,26 @@ fn map_prints_roles_conventions_and_rules() {
     assert!(row.contains("Bip01 L Calf") && row.contains("name (3ds Max Biped)"), "{row}");
 }
 
+/// A SOMA take (BONES-SEED): `LeftLeg` is the thigh and `LeftShin` the knee, by name.
+#[test]
+fn map_of_a_soma_take_names_leftleg_the_thigh() {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../fk/tests/data/soma/soma_walk_excerpt.bvh");
+    let out = retarget(&["bvh".as_ref(), "map".as_ref(), file.as_os_str()]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("names: SOMA (NVIDIA soma-retargeter, BONES-SEED)\n"), "{stdout}");
+    assert!(stdout.contains("unit:       0.01 m per file unit (centimetres"), "{stdout}");
+    assert!(stdout.contains("up axis:    +Y ("), "{stdout}");
+    for (role, joint) in [("left_thigh", "LeftLeg"), ("left_shin", "LeftShin")] {
+        let row = stdout.lines().find(|l| l.starts_with(&format!("{role} "))).unwrap();
+        assert!(
+            row.split_whitespace().nth(1) == Some(joint) && row.contains("name (SOMA"),
+            "{row}"
+        );
+    }
+}
+
 #[test]
 fn map_overrides_roles_from_json_and_reports_bad_maps() {
     let dir = temp_dir("map");

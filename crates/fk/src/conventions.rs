@@ -114,6 +114,28 @@ pub const CONVENTIONS: &[Convention] = &[
         ],
     },
     Convention {
+        name: "SOMA (NVIDIA soma-retargeter, BONES-SEED)",
+        source: "NVIDIA's SOMA uniform skeleton, the BVH of BONES-SEED and soma-retargeter \
+                 (Root on the floor, Hips, Spine1, Spine2, Chest, Neck1, Neck2; LeftLeg = \
+                 thigh, LeftShin = shin, LeftShoulder = clavicle; leaf joints such as HeadEnd \
+                 and LeftToeEnd are joints, not End Sites)",
+        parts: &[
+            (Pelvis, &["Hips"]),
+            (Spine, &["Spine1"]),
+            (Chest, &["Chest"]),
+            (Neck, &["Neck1"]),
+            (Head, &["Head"]),
+            (Clavicle, &["{Left}Shoulder"]),
+            (UpperArm, &["{Left}Arm"]),
+            (Forearm, &["{Left}ForeArm"]),
+            (Hand, &["{Left}Hand"]),
+            (Thigh, &["{Left}Leg"]),
+            (Shin, &["{Left}Shin"]),
+            (Foot, &["{Left}Foot"]),
+            (Toe, &["{Left}ToeBase"]),
+        ],
+    },
+    Convention {
         name: "Bandai Namco",
         source: "Bandai Namco Research motion dataset (joint_Root, UpperLeg_L, Toes_L, six \
                  channels on every joint)",
@@ -341,6 +363,17 @@ pub const IGNORED_WORDS: &[&str] = &[
     "twist", "roll", "ik", "ctrl", "control", "pole", "prop", "weapon", "sword", "gun", "arme",
     "helper", "holster", "attach",
 ];
+
+/// Whether a joint name marks the top of the head (`HeadTop_End`, `head_top`).
+pub(crate) fn names_the_top(name: &str) -> bool {
+    name.to_ascii_lowercase().contains("top")
+}
+
+/// Whether a joint name says it ends its chain, as an End Site does: its last word is `End`
+/// (`HeadEnd`, `LeftToeEnd`, `HeadTop_End`). SOMA writes such ends as joints with channels.
+pub(crate) fn names_an_end(name: &str) -> bool {
+    words(name).last().is_some_and(|w| w.eq_ignore_ascii_case("end"))
+}
 
 /// Exporter prefixes removed before comparing names (after the namespace, `mixamorig:`).
 const PREFIXES: &[&str] = &[
@@ -580,6 +613,9 @@ mod tests {
         assert!(roles("L_Foot").contains(&(Role::LeftToe, "SMPL")));
         assert!(roles("lFoot").contains(&(Role::LeftFoot, "Daz / Poser")));
         assert_eq!(roles("Bip01 R Calf"), [(Role::RightShin, "3ds Max Biped")]);
+        assert!(roles("LeftLeg").contains(&(Role::LeftShin, CONVENTIONS[0].name)));
+        assert!(roles("LeftLeg")
+            .contains(&(Role::LeftThigh, "SOMA (NVIDIA soma-retargeter, BONES-SEED)")));
         assert!(roles("LeftHandIndex1").is_empty());
         assert!(roles("HeadTop_End").is_empty());
     }
@@ -592,6 +628,8 @@ mod tests {
         assert_eq!(side("hand.L"), Some(Side::Left));
         assert_eq!(side("lowerback"), None);
         assert_eq!(side("joint7"), None);
+        assert!(names_an_end("HeadEnd") && names_an_end("HeadTop_End") && names_an_end("toe_end"));
+        assert!(!names_an_end("Legend") && !names_an_end("LeftHand"));
         assert!(is_ignored("upperarm_twist_01_l"));
         assert!(is_ignored("Bip01 L UpArmTwist"));
         assert!(is_ignored("ik_foot_l"));

@@ -203,15 +203,22 @@ impl Landmarks {
         head: Vec<usize>,
         feet: Vec<usize>,
     ) -> Landmarks {
-        let names: Vec<String> =
-            skeleton.joints.iter().map(|j| j.name.to_ascii_lowercase()).collect();
-        let all: Vec<usize> = (0..names.len()).collect();
+        let n = skeleton.joints.len();
+        let all: Vec<usize> = (0..n).collect();
+        let mut leaf = vec![true; n];
+        for joint in &skeleton.joints {
+            if let Some(p) = joint.parent {
+                leaf[p.0] = false;
+            }
+        }
+        // An End Site, or a leaf joint named as one (SOMA's `HeadEnd`), ends the head.
         let head_top = head.is_empty()
             || head.iter().any(|&i| {
                 let joint = &skeleton.joints[i];
                 let length = nalgebra::Vector3::from(joint.offset).norm() * metres_per_unit;
-                names[i].contains("top")
-                    || (joint.kind == bvh::JointKind::End && length >= HEAD_TOP_MIN)
+                let end = joint.kind == bvh::JointKind::End
+                    || (leaf[i] && crate::conventions::names_an_end(&joint.name));
+                crate::conventions::names_the_top(&joint.name) || (end && length >= HEAD_TOP_MIN)
             });
         Landmarks {
             head: if head.is_empty() { all.clone() } else { head },

@@ -435,3 +435,82 @@ fn given_roles_override_and_unknown_joints_are_errors() {
     let fk::Error::Unrecognised { missing, .. } = err else { panic!() };
     assert!(!missing.contains(&Role::Pelvis));
 }
+
+/// SOMA's role names, the same in every take of the rig (`LeftLeg` is the thigh here, the
+/// shin in LAFAN1 and Mixamo).
+const SOMA: ([&str; 5], [[&str; 4]; 2], [[&str; 4]; 2]) = (
+    ["Hips", "Spine1", "Chest", "Neck1", "Head"],
+    [
+        ["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand"],
+        ["RightShoulder", "RightArm", "RightForeArm", "RightHand"],
+    ],
+    [
+        ["LeftLeg", "LeftShin", "LeftFoot", "LeftToeBase"],
+        ["RightLeg", "RightShin", "RightFoot", "RightToeBase"],
+    ],
+);
+
+/// A SOMA take (`tests/data/soma/SOURCE.md`: eight frames of a BONES-SEED walk): the thigh
+/// is `LeftLeg` and the knee `LeftShin` by the SOMA convention, centimetres, Y up, a zero
+/// pose lying along +X (bone-axis aligned), and a 1.75 m subject whose head ends at the
+/// `HeadEnd` joint (a joint, not an End Site: no skull is added above it).
+#[test]
+fn soma_leftleg_is_the_thigh_and_leftshin_the_knee() {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/soma/soma_walk_excerpt.bvh");
+    let (motion, report) = run(&path, &FkOptions::default());
+    let h = humanoid(&report, "soma");
+    assert_eq!(h.convention, Some("SOMA (NVIDIA soma-retargeter, BONES-SEED)"));
+    expect(&h, "soma", SOMA.0, SOMA.1, SOMA.2);
+    for role in [Role::LeftThigh, Role::RightThigh, Role::LeftShin, Role::RightShin] {
+        let rule = &h.roles.get(role).unwrap().rule;
+        assert!(
+            matches!(rule, fk::Rule::Name { convention, .. } if convention.starts_with("SOMA")),
+            "{role}: {rule:?}"
+        );
+    }
+    assert_eq!(h.up, UpAxis::PosY, "{}", h.up_reason);
+    assert_eq!(report.axes, fk::AxisConvention::YUp);
+    assert_eq!(report.metres_per_unit, 0.01, "{}", report.unit_reason);
+    assert_eq!(h.rest_pose, RestPose::NotUpright, "{}", h.rest_reason);
+    assert!(matches!(h.reference, fk::Reference::Frame(_)), "{:?}", h.reference);
+    assert!(h.sides.starts_with("names (geometry agrees)"), "{}", h.sides);
+    assert!((1.72..1.78).contains(&report.height), "{} ({})", report.height, report.height_source);
+    // The thigh bone runs hip → knee (43 cm), the shin knee → ankle (42 cm), in every frame.
+    let at = |f: usize, name: &str| motion.position(f, motion.require_body(name).unwrap());
+    for f in 0..motion.num_frames {
+        for side in ["Left", "Right"] {
+            let (hip, knee, ankle) = (
+                at(f, &format!("{side}Leg")),
+                at(f, &format!("{side}Shin")),
+                at(f, &format!("{side}Foot")),
+            );
+            assert!(((hip - knee).norm() - 0.433).abs() < 0.002, "frame {f} {side}");
+            assert!(((knee - ankle).norm() - 0.423).abs() < 0.002, "frame {f} {side}");
+            assert!(hip.z > knee.z && knee.z > ankle.z, "frame {f} {side}: {hip} {knee} {ankle}");
+        }
+    }
+}
+
+/// The four SOMA takes of the shared data: the same roles, unit and axes as the excerpt.
+#[test]
+fn every_shared_soma_take_gets_the_soma_roles() {
+    let Some(dir) = shared::shared_file("data/soma") else { return };
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let file = path.file_name().unwrap().to_string_lossy().into_owned();
+        if !file.ends_with(".bvh") {
+            continue;
+        }
+        seen += 1;
+        let (_, report) = run(&path, &FkOptions::default());
+        let h = humanoid(&report, &file);
+        expect(&h, &file, SOMA.0, SOMA.1, SOMA.2);
+        assert_eq!(h.up, UpAxis::PosY, "{file}: {}", h.up_reason);
+        assert_eq!(report.metres_per_unit, 0.01, "{file}");
+        assert_eq!(h.rest_pose, RestPose::NotUpright, "{file}");
+        assert!(h.sides.starts_with("names (geometry agrees)"), "{file}: {}", h.sides);
+    }
+    assert_eq!(seen, 4);
+}

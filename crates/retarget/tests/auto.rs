@@ -283,6 +283,36 @@ fn every_shared_bvh_onto_the_g1_and_the_t1() {
     }
 }
 
+/// Issue 43: the four SOMA takes (BONES-SEED, `data/soma`: `LeftLeg` the thigh, `LeftShin`
+/// the knee, a zero pose lying along +X) onto the G1 with no config: the derived config, the
+/// pelvis and chest upright wherever the human's are, the legs alternating as the human's.
+#[test]
+fn every_soma_take_onto_the_g1() {
+    let Some(dir) = shared::shared_file("data/soma") else { return };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4, "{files:?}");
+    let key = "unitree_g1";
+    let model = shipped_model(key);
+    let tuned = tuned(key);
+    for file in &files {
+        let bvh = first_frames(bvh::from_path(file).unwrap(), FRAMES);
+        let name = file.file_name().unwrap().to_string_lossy().into_owned();
+        let checks = run(&model, key, &bvh, tuned.as_ref());
+        let what = format!("{name} → {key}");
+        // Legs alternate wherever the human's do (the walk and the dance; the jump and the
+        // pick-up stand on both feet).
+        assert_sane(&what, &checks, checks.alternations.1 >= 2);
+        assert_eq!(checks.choice, Choice::Derived, "{what}");
+        assert!(checks.upright_with_human >= 0.95, "{what}: {checks:?}");
+        assert!(checks.contact.is_some(), "{what}: no source contacts");
+    }
+}
+
 /// Issue 33: the four shared FBX files (MotionBuilder, Maya rig controls, the one-bone-per-
 /// limb Blender barbarian with straight limbs, the 0.63 m XNA dude), their default take, onto
 /// the G1 and the T1 with no config, in both solves.

@@ -168,3 +168,45 @@ fn retargeters_are_shared_between_threads() {
     assert!(err.contains("my_robot"), "{err}");
     assert!(Retargeter::shipped("robots/unitree_g1.xml").is_err());
 }
+
+/// GMR PR #169's SOMA path (unmerged in GMR): its loader (`load_bvh_gmr`, `GmrBvhFormat::Soma`:
+/// facing +X, 1.70 m) and GMR's solve with the PR's `bvh_soma` config, against our BVH path
+/// under `--gmr` with the height given (facing −Y, LAFAN1's turn): a yaw of the world apart,
+/// the same targets, so the same joint angles once GMR's first frame has turned the robot.
+#[test]
+fn gmr_soma_loader_and_our_fk_agree_but_for_the_heading() {
+    let Some(config) =
+        shared::shared_file("reference/gmr_ik_configs/pr169_bvh_soma/bvh_soma_to_g1.json")
+    else {
+        return;
+    };
+    let config = retarget::IkConfig::from_file(&config).unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fk/tests/data/soma/soma_walk_excerpt.bvh");
+    let bvh = bvh::from_path(&path).unwrap();
+    let options = {
+        let mut o = RetargetOptions::default();
+        o.mode = SolveMode::Gmr;
+        o
+    };
+    let retargeter = || {
+        Retargeter::new("unitree_g1")
+            .unwrap()
+            .with_options(options.clone())
+            .with_config(config.clone())
+    };
+    let human = retarget::load_bvh_gmr(&bvh, retarget::GmrBvhFormat::Soma).unwrap();
+    let (theirs, _) = retargeter().retarget(&human).unwrap();
+    let (mine, _) = retargeter().with_human_height(Some(1.70)).retarget_bvh(&bvh).unwrap();
+    for f in 0..bvh.motion.num_frames {
+        let (a, b) = (theirs.frame(f), mine.frame(f));
+        let joints = max_difference(&a[7..], &b[7..]);
+        // World (x, y) facing +X is (file z, file x); facing −Y it is (file x, −file z).
+        let root = max_difference(&[a[1], -a[0], a[2]], &b[..3]);
+        println!("frame {f}: joints differ by {joints:.1e} rad, the root by {root:.1e} m");
+        // GMR's first frame starts from qpos0 facing +X: turned a quarter more, it ends 0.03
+        // rad away; the next frames close the gap (×30 each).
+        let tolerance = if f < 3 { 0.05 } else { 1e-6 };
+        assert!(joints < tolerance && root < tolerance, "frame {f}: {joints:.1e}, {root:.1e}");
+    }
+}
