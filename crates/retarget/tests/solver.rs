@@ -182,8 +182,7 @@ fn every_shipped_config_fits_its_robot_and_lafan1() {
 fn unknown_names_are_located_with_suggestions() {
     let Some(human) = lafan1_bodies() else { return };
     let model = g1();
-    let text =
-        std::fs::read_to_string(repo().join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let text = std::fs::read_to_string(repo().join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let bad = text.replace("\"left_knee_link\"", "\"left_kne_link\"");
     let config = IkConfig::from_json_str(&bad, "g1.json").unwrap();
     let err = config.validate(&model, &human).unwrap_err().to_string();
