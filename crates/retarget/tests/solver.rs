@@ -160,22 +160,16 @@ fn lafan1_bodies() -> Option<Vec<String>> {
 #[test]
 fn every_shipped_config_fits_its_robot_and_lafan1() {
     let Some(human) = lafan1_bodies() else { return };
-    let dir = repo().join("configs");
     let mut count = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let Some(key) = name.strip_prefix("bvh_lafan1_to_").and_then(|n| n.strip_suffix(".json"))
-        else {
-            continue;
-        };
+    for config in retarget::shipped::CONFIGS.iter().filter(|c| c.source == "bvh_lafan1") {
+        let key = config.robot;
         let model_path = repo().join(format!("robots/{key}/{key}.xml"));
         let model = Model::from_file(&model_path).unwrap_or_else(|e| panic!("{key}: {e}"));
-        let config = IkConfig::from_file(&path).unwrap();
-        config.validate(&model, &human).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let parsed = IkConfig::from_file(&repo().join(config.path)).unwrap();
+        parsed.validate(&model, &human).unwrap_or_else(|e| panic!("{}: {e}", config.path));
         count += 1;
     }
-    assert!(count >= 6, "only {count} shipped configs");
+    assert!(count >= 8, "only {count} shipped configs");
 }
 
 #[test]
