@@ -654,7 +654,8 @@ fn every_shipped_robot_walks_the_smpl_walks_in_both_solves() {
 /// 300 frames of the LAFAN1 walk with no config (the derived one), the default solve, with its
 /// joint speed limits: upright, facing, feet alternating, no joint outside its range, no
 /// sole below the floor by more than the report's tolerance and no self-penetration deeper
-/// than the report's `self_collision_depth`; with the pairs our models overlap at rest counted.
+/// than the report's `self_collision_depth`, and no primitives of ours touching at `qpos0`
+/// (such pairs would be left out of the self-collision constraint unnoticed).
 #[test]
 fn every_shipped_robot_walks_the_lafan1_walk_with_no_config() {
     let Some(bvh) = lafan_walk() else { return };
@@ -689,5 +690,6 @@ fn every_shipped_robot_walks_the_lafan1_walk_with_no_config() {
         assert_eq!(ground.duration, 0.0, "{}: sole below the floor", robot.key);
         assert_eq!(own.frames_deep, 0, "{}: self-penetration {:?}", robot.key, own.worst_pair);
         assert!(own.pairs > 0, "{}: no self-collision pairs checked", robot.key);
+        assert_eq!(own.ignored_pairs, 0, "{}: primitives touching at qpos0", robot.key);
     }
 }
