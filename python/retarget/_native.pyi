@@ -135,7 +135,7 @@ class Retargeter:
         ``betas``, ``fps``); the body model folder from ``body_model`` or
         ``$RETARGET_BODY_MODELS``."""
     def select_config(self, source: str) -> None:
-        """Use the shipped config for ``"bvh_lafan1"`` or ``"smplx"`` (GMR's ``src_human``)."""
+        """Use the shipped config of GMR's ``src_human`` ``source`` (``gmr_configs``)."""
     def retarget_c3d(self, path: PathLike, config: PathLike) -> Motion:
         """With a marker-driven IK config (``marker_bodies`` + IK tables)."""
     def retarget_frames(self, frames: Sequence[HumanData], fps: float = 30.0) -> Motion:
@@ -165,3 +165,7 @@ def batch(
     human_height: Optional[float] = None,
 ) -> List[Dict[str, Any]]: ...
 def shipped_robots() -> List[str]: ...
+def gmr_configs() -> List[Tuple[str, str, str]]:
+    """The shipped configs as ``(source, robot, path)`` (GMR's ``IK_CONFIG_DICT``)."""
+def not_shipped_robots() -> List[Tuple[str, str, str]]:
+    """GMR's robot keys not shipped, as ``(key, reason, upstream path in GMR)``."""

@@ -12,13 +12,24 @@ an ``.fbx`` file itself into the frames GMR's FBX path (FBX SDK + poselib pickle
 
 SMPL-X (AMASS): ``load_smplx_file`` and ``get_smplx_data_offline_fast`` return what GMR's do
 (the human data to 1e-6 m of GMR's own, float32 smplx), and ``src_human="smplx"`` takes GMR's
-``smplx_to_*`` config where one ships (unitree_g1, booster_t1_29dof):
+``smplx_to_*`` config of the robot (``IK_CONFIG_DICT["smplx"]``):
 
 >>> from retarget.gmr import load_smplx_file, get_smplx_data_offline_fast       # doctest: +SKIP
 >>> data, body_model, output, height = load_smplx_file("walk_stageii.npz", "body_models")  # doctest: +SKIP
 >>> frames, fps = get_smplx_data_offline_fast(data, body_model, output, tgt_fps=30)  # doctest: +SKIP
 
-Differences: only GMR's ``bvh_lafan1`` configs and the ``smplx`` configs above ship; the solver is
+Robots and sources: ``tgt_robot`` is any of GMR's 18 robot keys; the models of
+``NOT_SHIPPED_ROBOTS`` are not shipped (their licence), and naming one raises
+``RetargetError`` saying where GMR's model is and how to pass it (``Retargeter("model.xml")``
+in ``retarget``). ``src_human`` is any of GMR master's sources whose config GMR has for that
+robot (``IK_CONFIG_DICT``, GMR's own files byte-identical in ``configs/gmr/``): frames come
+from ``load_bvh_file`` (``bvh_lafan1``, ``bvh_nokov``), ``load_smplx_file`` (``smplx``) and
+``load_optitrack_fbx_motion_file`` (``fbx``, ``fbx_offline``); ``bvh_xsens``, ``xsens_mvn``
+and ``xrobot`` have no loader here (an Xsens BVH export's joint names, GMR's live Xsens MVN
+and XRoboToolkit streams): pass their frames yourself. A source GMR has no config for
+raises ``KeyError``.
+
+Differences: the solver is
 exact whatever ``solver`` names (GMR: daqp); ``use_velocity_limit`` changes nothing (GMR passes
 its velocity limits into mink's ``safety_break`` argument, so GMR never applies them either);
 nothing is printed (``verbose``); there is no MuJoCo model (``model``, ``configuration``).
@@ -43,11 +54,19 @@ __all__ = [
     "get_smplx_data_offline_fast",
 ]
 
-#: GMR's ``src_human`` names we have configs for, by robot: GMR's ``IK_CONFIG_DICT``.
-IK_CONFIG_DICT: Dict[str, Dict[str, str]] = {
-    "bvh_lafan1": {key: f"configs/bvh_lafan1_to_{key}.json" for key in _native.shipped_robots()},
-    "smplx": {key: f"configs/smplx_to_{key}.json" for key in ("booster_t1_29dof", "unitree_g1")},
+#: GMR's ``src_human`` names we have configs for, by robot: GMR's ``IK_CONFIG_DICT`` for
+#: the shipped robots (paths in the repository; the table is ``retarget::shipped::CONFIGS``).
+IK_CONFIG_DICT: Dict[str, Dict[str, str]] = {}
+for _source, _robot, _path in _native.gmr_configs():
+    IK_CONFIG_DICT.setdefault(_source, {})[_robot] = _path
+
+#: GMR's robot keys whose models are not shipped: ``{key: (reason, upstream path in GMR)}``.
+NOT_SHIPPED_ROBOTS: Dict[str, Tuple[str, str]] = {
+    key: (reason, upstream) for key, reason, upstream in _native.not_shipped_robots()
 }
+
+#: GMR master's ``src_human`` names (its ``IK_CONFIG_DICT`` keys).
+GMR_SOURCES = ("smplx", "bvh_lafan1", "bvh_nokov", "bvh_xsens", "fbx", "fbx_offline", "xrobot", "xsens_mvn")
 
 HumanData = Mapping[str, Sequence[Any]]
 
@@ -150,10 +169,16 @@ class GeneralMotionRetargeting:
         verbose: bool = True,
         use_velocity_limit: bool = False,
     ) -> None:
-        if src_human not in IK_CONFIG_DICT:
-            raise KeyError(f"{src_human!r}: configs ship for {sorted(IK_CONFIG_DICT)} only")
-        if tgt_robot not in IK_CONFIG_DICT[src_human]:
-            raise KeyError(f"{tgt_robot!r}: shipped robots are {sorted(IK_CONFIG_DICT[src_human])}")
+        if src_human not in GMR_SOURCES:
+            raise KeyError(f"src_human {src_human!r}: not one of GMR's sources {list(GMR_SOURCES)}")
+        if tgt_robot in NOT_SHIPPED_ROBOTS:
+            _native.Retargeter(tgt_robot)  # raises RetargetError: where to get the model
+        if tgt_robot not in IK_CONFIG_DICT.get(src_human, {}):
+            having = sorted(IK_CONFIG_DICT.get(src_human, {}))
+            raise KeyError(
+                f"src_human {src_human!r}, tgt_robot {tgt_robot!r}: no {src_human} config ships for "
+                f"{tgt_robot} (GMR has none either); robots with one: {having}"
+            )
         if damping != 5e-1:
             raise NotImplementedError("damping other than GMR's default 0.5")
         self.src_human = src_human

@@ -222,18 +222,19 @@ impl Retargeter {
         Ok(Motion::new(motion, diag, inner.shared_model()))
     }
 
-    /// Use the shipped robot's config for ``source``: ``"bvh_lafan1"`` (GMR's LAFAN1 config,
-    /// the default for frames) or ``"smplx"`` (GMR's ``smplx_to_*`` config), as GMR's
-    /// ``src_human`` chooses it.
+    /// Use the shipped robot's config for ``source``, GMR's ``src_human``: ``"bvh_lafan1"``
+    /// (GMR's LAFAN1 config, the default for frames), ``"smplx"`` (GMR's ``smplx_to_*``
+    /// config) or any other source GMR has a config of this robot for (``"bvh_nokov"``,
+    /// ``"bvh_xsens"``, ``"fbx"``, ``"fbx_offline"``, ``"xsens_mvn"``, ``"xrobot"``; see
+    /// ``gmr_configs``), as GMR's ``IK_CONFIG_DICT`` chooses it.
     fn select_config(&mut self, source: &str) -> PyResult<()> {
         let config = match source {
             "bvh_lafan1" => self.inner.tuned_config().cloned(),
             "smplx" => self.inner.smplx_config().cloned(),
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "source {other:?}: expected \"bvh_lafan1\" or \"smplx\""
-                )))
-            }
+            other => retarget::shipped::config(other, self.inner.label())
+                .map(retarget::shipped::ShippedConfig::parse)
+                .transpose()
+                .map_err(|e| RetargetError::new_err(e.to_string()))?,
         };
         let config = config.ok_or_else(|| {
             RetargetError::new_err(format!(
@@ -766,12 +767,27 @@ fn shipped_robots() -> Vec<&'static str> {
     retarget::shipped::keys().collect()
 }
 
+/// The shipped configs as ``(source, robot, path)``: GMR's ``IK_CONFIG_DICT`` for the
+/// shipped robots (``retarget::shipped::CONFIGS``).
+#[pyfunction]
+fn gmr_configs() -> Vec<(&'static str, &'static str, &'static str)> {
+    retarget::shipped::CONFIGS.iter().map(|c| (c.source, c.robot, c.path)).collect()
+}
+
+/// GMR's robot keys whose models are not shipped, as ``(key, reason, upstream path)``.
+#[pyfunction]
+fn not_shipped_robots() -> Vec<(&'static str, &'static str, &'static str)> {
+    retarget::shipped::NOT_SHIPPED.iter().map(|r| (r.key, r.reason, r.upstream)).collect()
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Retargeter>()?;
     m.add_class::<Motion>()?;
     m.add("RetargetError", m.py().get_type::<RetargetError>())?;
     m.add_function(wrap_pyfunction!(load_bvh_gmr, m)?)?;
+    m.add_function(wrap_pyfunction!(gmr_configs, m)?)?;
+    m.add_function(wrap_pyfunction!(not_shipped_robots, m)?)?;
     m.add_function(wrap_pyfunction!(load_fbx_frames, m)?)?;
     m.add_function(wrap_pyfunction!(smpl::load_smplx_gmr, m)?)?;
     m.add_function(wrap_pyfunction!(batch, m)?)?;

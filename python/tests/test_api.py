@@ -39,7 +39,7 @@ def test_import_is_light_and_gmr_loads_on_first_use():
 
 def test_robots_and_configs_from_files(root, shared):
     robot = root / "robots/unitree_g1/unitree_g1.xml"
-    config = root / "configs/bvh_lafan1_to_unitree_g1.json"
+    config = root / "configs/gmr/bvh_lafan1_to_g1.json"
     from_files = retarget.Retargeter(robot=str(robot), config=str(config), mode="gmr")
     shipped = retarget.Retargeter("unitree_g1", mode="gmr")
     assert from_files.robot == "unitree_g1" and from_files.nq == shipped.nq == 36

@@ -47,7 +47,7 @@ def test_arrays_are_read_only_views(walk_outputs):
     assert qpos is motion.qpos or np.shares_memory(qpos, motion.qpos)
     with pytest.raises(ValueError):
         qpos[0, 0] = 1.0
-    assert "config configs/bvh_lafan1_to_unitree_g1.json" in motion.inferred
+    assert "config configs/gmr/bvh_lafan1_to_g1.json" in motion.inferred
     reweigh = motion.stages["reweigh"]  # GMR's G1 config holds the pelvis under the legs
     offset, share = reweigh["pelvis_offset"], reweigh["share"]
     assert 0.01 < offset < 0.03 and share > 0.5, motion.stages

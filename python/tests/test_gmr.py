@@ -77,8 +77,53 @@ def test_gmrs_attributes_and_refusals():
         assert scale == pytest.approx(unscaled.human_scale_table[body] * 1.1)
     assert gmr.robot_body_names["world"] == 0 and gmr.robot_dof_names["left_hip_pitch_joint"] == 6
     with pytest.raises(KeyError):
-        GMR(src_human="smplx", tgt_robot="unitree_h1")  # GMR has smplx_to_h1; we do not ship it
+        GMR(src_human="bvh_lafan1", tgt_robot="pnd_adam_lite")  # GMR has no LAFAN1 config either
     with pytest.raises(KeyError):
         GMR(src_human="bvh_lafan1", tgt_robot="no_such_robot")
     with pytest.raises(NotImplementedError):
         gmr.retarget({}, offset_to_ground=True)
+
+
+#: GMR master's 18 robot keys (``ROBOT_XML_DICT``).
+GMR_ROBOTS = [
+    "unitree_g1", "unitree_g1_with_hands", "unitree_h1", "unitree_h1_2", "booster_t1",
+    "booster_t1_29dof", "booster_k1", "stanford_toddy", "fourier_n1", "engineai_pm01",
+    "hightorque_hi", "galaxea_r1pro", "kuavo_s45", "berkeley_humanoid_lite", "pnd_adam_lite",
+    "tienkung", "pal_talos", "fourier_gr3",
+]
+
+
+def test_every_gmr_robot_key_is_accepted_or_refused_with_where_to_get_it():
+    from retarget import RetargetError
+    from retarget.gmr import IK_CONFIG_DICT, NOT_SHIPPED_ROBOTS
+
+    shipped = set(_native_keys())
+    assert shipped | set(NOT_SHIPPED_ROBOTS) == set(GMR_ROBOTS)
+    for key in GMR_ROBOTS:
+        sources = [s for s, robots in IK_CONFIG_DICT.items() if key in robots]
+        if key in NOT_SHIPPED_ROBOTS:
+            with pytest.raises(RetargetError, match=key) as error:
+                GMR(src_human="smplx", tgt_robot=key)
+            upstream = NOT_SHIPPED_ROBOTS[key][1]
+            assert upstream in str(error.value) and "--robot path/to/" in str(error.value)
+            continue
+        for source in sources:
+            gmr = GMR(src_human=source, tgt_robot=key)
+            assert gmr.robot_dof_names, (source, key)
+
+
+def test_every_gmr_source_with_a_config():
+    from retarget.gmr import IK_CONFIG_DICT
+
+    # GMR master's IK_CONFIG_DICT for the G1: every source has its config.
+    for source in ["smplx", "bvh_lafan1", "bvh_nokov", "bvh_xsens", "fbx", "fbx_offline", "xrobot", "xsens_mvn"]:
+        assert "unitree_g1" in IK_CONFIG_DICT[source], source
+        assert GMR(src_human=source, tgt_robot="unitree_g1").human_root_name
+    with pytest.raises(KeyError, match="not one of GMR's sources"):
+        GMR(src_human="bvh_soma", tgt_robot="unitree_g1")  # an unmerged GMR pull request
+
+
+def _native_keys():
+    from retarget import _native
+
+    return _native.shipped_robots()

@@ -24,7 +24,7 @@ def test_file_equals_cli_and_arrays_equal_file(smpl, cli, tmp_path):
     models = smpl / "body_models"
     r = retarget.Retargeter("unitree_g1")
     motion = r.retarget_smplx(walk, body_model=models)
-    assert "SMPL+H body model" in motion.inferred and "smplx_to_unitree_g1" in motion.inferred
+    assert "SMPL+H body model" in motion.inferred and "configs/gmr/smplx_to_g1.json" in motion.inferred
     out = tmp_path / "walk.npz"
     subprocess.run([str(cli), "--smplx", str(walk), "--robot", "unitree_g1", "--body-model",
                     str(models), "-o", str(out)], check=True, capture_output=True)

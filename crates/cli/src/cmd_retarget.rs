@@ -95,7 +95,7 @@ pub fn solve_mode(gmr: bool, both_ways: bool) -> SolveMode {
     }
 }
 
-/// The tuned IK config of shipped robot `key` (`configs/bvh_lafan1_to_<key>.json`).
+/// The tuned IK config of shipped robot `key` (its `bvh_lafan1` row of `retarget::shipped::CONFIGS`).
 pub fn shipped_config(key: &str) -> Option<anyhow::Result<IkConfig>> {
     retarget::shipped::tuned_config(key).map(|r| r.map_err(anyhow::Error::from))
 }

@@ -66,11 +66,19 @@ fn emit(text: &str) -> anyhow::Result<()> {
 }
 
 pub fn list() -> anyhow::Result<ExitCode> {
-    let mut out = format!("{:<20} {:>4} {:>4} {:>5} {:>7}\n", "robot", "nq", "nv", "dof", "bodies");
+    let mut out = format!("{:<22} {:>4} {:>4} {:>5} {:>7}\n", "robot", "nq", "nv", "dof", "bodies");
     for key in shipped::shipped_keys() {
         let model = shipped::robot_model(key)?;
         let (nq, nv, dof, nbody) = (model.nq, model.nv, joint_dofs(&model), model.nbody());
-        writeln!(out, "{key:<20} {nq:>4} {nv:>4} {dof:>5} {nbody:>7}")?;
+        writeln!(out, "{key:<22} {nq:>4} {nv:>4} {dof:>5} {nbody:>7}")?;
+    }
+    writeln!(
+        out,
+        "\nGMR's robots not shipped (get the model upstream, pass --robot path/to/model.xml):"
+    )?;
+    for robot in retarget::shipped::NOT_SHIPPED {
+        let (key, reason, upstream) = (robot.key, robot.reason, robot.upstream);
+        writeln!(out, "{key:<22} YanjieZe/GMR {upstream}: {reason}")?;
     }
     emit(&out)?;
     Ok(ExitCode::SUCCESS)

@@ -97,7 +97,7 @@ fn mjcf_path_without_config_derives_one_and_init_writes_it() {
     // The shipped robot keeps GMR's tuned config on a LAFAN1 skeleton.
     let out = retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", "unitree_g1"]);
     let (stdout, _) = text(&out);
-    assert!(stdout.contains("bvh_lafan1_to_unitree_g1.json (tuned"), "{stdout}");
+    assert!(stdout.contains("configs/gmr/bvh_lafan1_to_g1.json (tuned"), "{stdout}");
     // `robot init` writes a role-named config; --config binds it to the skeleton.
     let config = dir.join("g1.json");
     let out = retarget(&["robot", "init", xml.to_str().unwrap(), "-o", config.to_str().unwrap()]);
@@ -188,14 +188,14 @@ fn fps_resamples_the_output_and_unknown_robots_are_named() {
     // An unknown robot is reported by the robot lookup (with a config that exists, so the
     // config cannot be what fails): the shipped robots are listed, the nearest name offered.
     let config =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/gmr/bvh_lafan1_to_g1.json");
     for extra in [&["--config", config.to_str().unwrap()][..], &[]] {
         let args = [&["--bvh", "x.bvh", "--robot", "no_such_robot"][..], extra].concat();
         let out = retarget(&args);
         assert_eq!(out.status.code(), Some(1));
         let stderr = text(&out).1;
         assert!(
-            stderr.starts_with("error: unknown robot \"no_such_robot\": not a shipped robot (booster_t1_29dof, engineai_pm01, fourier_n1, stanford_toddy, unitree_g1, unitree_h1"),
+            stderr.starts_with("error: unknown robot \"no_such_robot\": not a shipped robot (berkeley_humanoid_lite, booster_t1_29dof, engineai_pm01, fourier_n1, pal_talos, pnd_adam_lite, stanford_toddy, unitree_g1, unitree_g1_with_hands, unitree_h1"),
             "{extra:?}: {stderr}"
         );
         assert!(!stderr.contains("did you mean"), "{stderr}");
@@ -221,7 +221,7 @@ fn urdf_robot_retargets_with_the_g1_config() {
         return;
     };
     let config =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/gmr/bvh_lafan1_to_g1.json");
     let mut outputs = Vec::new();
     for (robot, name) in [(urdf.to_str().unwrap(), "urdf.npz"), ("unitree_g1", "mjcf.npz")] {
         let path = dir.join(name);

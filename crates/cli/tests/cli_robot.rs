@@ -44,7 +44,7 @@ fn robots_lists_shipped_models_with_sizes() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = stdout(&out);
     assert!(text.starts_with("robot "), "{text}");
-    let rows: Vec<&str> = text.lines().skip(1).collect();
+    let rows: Vec<&str> = text.lines().skip(1).take_while(|l| !l.is_empty()).collect();
     let keys: Vec<&str> = rows.iter().filter_map(|r| r.split_whitespace().next()).collect();
     for key in &keys {
         assert!(
@@ -140,6 +140,35 @@ fn robot_info_reads_a_urdf() {
     let knee = hinges.iter().find(|l| l.contains(" left_knee_joint ")).expect("knee");
     assert!(knee.contains("[-0.0873, 2.8798] rad") && knee.contains("speed 20 rad/s"), "{knee}");
     assert!(text.contains("pelvis_free_joint                free"), "{text}");
+}
+
+/// GMR's robot keys whose models we do not ship: listed with the reason, and `--robot KEY`
+/// fails naming the key, the upstream file and how to pass it.
+#[test]
+fn gmrs_robots_not_shipped_are_listed_and_refused_with_where_to_get_them() {
+    let text = stdout(&retarget(&["robots"]));
+    let (shipped, not_shipped) = text.split_once("\n\n").expect("two sections");
+    assert_eq!(shipped.lines().count() - 1, repo_robot_keys().len(), "{text}");
+    let rows: Vec<&str> = not_shipped.lines().skip(1).collect();
+    assert_eq!(rows.len() + repo_robot_keys().len(), 18, "GMR's 18 keys: {text}");
+    let bvh = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/samples/lafan1_walk.bvh");
+    for row in rows {
+        let key = row.split_whitespace().next().unwrap();
+        assert!(row.contains("YanjieZe/GMR assets/"), "{row}");
+        let out =
+            retarget(&["--bvh", bvh.to_str().unwrap(), "--robot", key, "-o", "/nonexistent/x.npz"]);
+        assert_eq!(out.status.code(), Some(1), "{key}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!(
+                "robot \"{key}\" is one of GMR's robots, but its model is not shipped"
+            )) && err.contains("https://github.com/YanjieZe/GMR")
+                && err.contains("--robot path/to/"),
+            "{err}"
+        );
+        let out = retarget(&["robot", "info", key]);
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--robot path/to/"), "{key}");
+    }
 }
 
 #[test]

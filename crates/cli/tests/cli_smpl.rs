@@ -88,7 +88,7 @@ fn info_retarget_and_errors() {
         retarget(&["--smplx", clip.to_str().unwrap(), "--robot", "unitree_g1"], Some(&models));
     assert!(out.status.success(), "{}", text(&out));
     let written = work.join("walk_stageii_unitree_g1.npz");
-    assert!(text(&out).contains("configs/smplx_to_unitree_g1.json"), "{}", text(&out));
+    assert!(text(&out).contains("configs/gmr/smplx_to_g1.json"), "{}", text(&out));
     let motion = retarget::writers::read_motion_npz(&written).unwrap();
     assert_eq!((motion.num_frames(), motion.fps), (240, 120.0));
     let out = retarget(

@@ -25,7 +25,7 @@ fn bench_solve(c: &mut Criterion) {
         mjcf::Model::from_file(&shared.join("reference/robots/unitree_g1/g1_mocap_29dof.xml"))
             .unwrap();
     let config_path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/gmr/bvh_lafan1_to_g1.json");
     let config = IkConfig::from_file(&config_path).unwrap();
     let (human, _) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
     let map = TargetMap::new(&config, &human.body_names, 1.75).unwrap();

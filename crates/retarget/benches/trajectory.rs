@@ -52,7 +52,7 @@ fn window(root: &Path) -> Option<Window> {
     }
     let bvh = bvh::from_path(&walk).unwrap();
     let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let config = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let (human, _) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
     let map = TargetMap::new(&config, &human.body_names, 1.75).unwrap();
     let stages = task_specs(&config, &model, &map);

@@ -86,6 +86,11 @@ pub(crate) struct ConfigFile {
     /// GMR reads it (initial joint values); accepted, not used yet.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) robot_initial_qpos: Option<serde_json::Value>,
+    /// GMR's mink collision-avoidance limit (`xsens_mvn_to_g1.json`: `enabled`,
+    /// `min_distance`, `detection_distance`, `self_collision_pairs`): accepted, not used.
+    /// GMR's own file has it disabled; our default solve keeps every collision pair apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) collision_avoidance: Option<serde_json::Value>,
     /// Marker-driven configs (`retarget --c3d`): read by the CLI, ignored here.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) marker_bodies: Option<serde_json::Value>,

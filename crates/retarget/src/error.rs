@@ -38,6 +38,13 @@ pub enum Error {
         nearest.as_ref().map_or(String::new(), |k| format!("; did you mean {k}?"))
     )]
     UnknownRobot { name: String, shipped: Vec<String>, nearest: Option<String> },
+    /// One of GMR's robot keys whose model we do not ship (`shipped::NOT_SHIPPED`).
+    #[error(
+        "robot \"{key}\" is one of GMR's robots, but its model is not shipped ({reason}); get \
+         {upstream} from https://github.com/YanjieZe/GMR and pass it: --robot path/to/{}",
+        upstream.rsplit('/').next().unwrap_or(upstream)
+    )]
+    NotShipped { key: String, reason: String, upstream: String },
     /// An error about one input file, with its path.
     #[error("{path}: {source}")]
     InFile {

@@ -48,7 +48,7 @@
 //! let retargeter = Retargeter::new("unitree_g1")?.with_mode(SolveMode::Gmr);
 //! let (motion, diagnostics) = retargeter.retarget_bvh(&bvh)?;
 //! assert_eq!((motion.num_frames(), motion.nq), (2, 36));
-//! assert!(diagnostics.human_inferred.contains("bvh_lafan1_to_unitree_g1"));
+//! assert!(diagnostics.human_inferred.contains("configs/gmr/bvh_lafan1_to_g1.json"));
 //!
 //! // Write it as BeyondMimic's npz (or .csv, .pkl, .json) and measure it.
 //! let path = std::env::temp_dir().join(format!("retarget-doc-{}.npz", std::process::id()));

@@ -128,10 +128,7 @@ impl Retargeter {
     /// an MJCF (`.xml`) or URDF (`.urdf`) file ([`shipped::load_robot`]); the default options.
     pub fn new(robot: &str) -> Result<Retargeter, Error> {
         let (model, notes) = shipped::load_robot_noted(robot)?;
-        let tuned = match shipped::find(robot) {
-            Some(r) => Some(r.config()?),
-            None => None,
-        };
+        let tuned = shipped::tuned_config(robot).transpose()?;
         let mut retargeter = Retargeter::from_model(model, &shipped::robot_label(robot));
         retargeter.tuned = tuned;
         retargeter.notes = notes;
@@ -142,7 +139,7 @@ impl Retargeter {
     /// A shipped robot by key; an error for anything else.
     pub fn shipped(key: &str) -> Result<Retargeter, Error> {
         if shipped::find(key).is_none() {
-            return Err(shipped::unknown_robot(key));
+            return Err(shipped::refused(key).unwrap_or_else(|| shipped::unknown_robot(key)));
         }
         Retargeter::new(key)
     }
@@ -261,7 +258,7 @@ impl Retargeter {
         self.tuned.as_ref()
     }
 
-    /// The shipped robot's SMPL-X config (`configs/smplx_to_<key>.json`, GMR's), if it has one.
+    /// The shipped robot's SMPL-X config (GMR's `smplx_to_*.json`, `shipped::CONFIGS`), if it has one.
     #[must_use]
     pub fn smplx_config(&self) -> Option<&IkConfig> {
         self.smplx.as_ref()

@@ -27,8 +27,7 @@ fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
 }
 
 fn tuned(key: &str) -> Option<IkConfig> {
-    let path = root().join(format!("configs/bvh_lafan1_to_{key}.json"));
-    path.is_file().then(|| IkConfig::from_file(&path).unwrap())
+    retarget::shipped::tuned_config(key).map(Result::unwrap)
 }
 
 /// What the checks measured on one retarget.
@@ -56,6 +55,8 @@ struct Checks {
     /// Share of frames in which the source's left / right foot is in contact (the feet are
     /// found by their roles, whatever the skeleton names them); `None` without contacts.
     contact: Option<[f64; 2]>,
+    /// `retarget report` of the motion (set by [`run_with`]).
+    quality: Option<Box<retarget::report::QualityReport>>,
 }
 
 fn run(model: &mjcf::Model, robot: &str, bvh: &bvh::Bvh, tuned: Option<&IkConfig>) -> Checks {
@@ -103,6 +104,7 @@ fn run_with(
         let share = |v: &[bool]| v.iter().filter(|&&x| x).count() as f64 / v.len().max(1) as f64;
         [share(&c.left), share(&c.right)]
     });
+    checks.quality = Some(Box::new(quality));
     checks
 }
 
@@ -178,6 +180,7 @@ fn measure(
         feet_on_floor: None,
         choice,
         contact: None,
+        quality: None,
     }
 }
 
@@ -216,7 +219,14 @@ fn violations(model: &mjcf::Model, motion: &RobotMotion) -> usize {
 }
 
 fn assert_sane(what: &str, c: &Checks, walk: bool) {
-    println!("{what}: {c:?}");
+    let Checks { upright, upright_with_human, facing, feet, alternations, violations, .. } = c;
+    let (leg_rotation, feet_on_floor, choice, contact) =
+        (c.leg_rotation, c.feet_on_floor, &c.choice, c.contact);
+    println!(
+        "{what}: upright {upright:?} with human {upright_with_human:.3} facing {facing:.3} \
+         feet {feet:.3} alternations {alternations:?} violations {violations} leg rotation \
+         {leg_rotation:.3} feet on floor {feet_on_floor:?} {choice:?} contact {contact:?}"
+    );
     let (robot, human) = c.upright;
     assert!(
         robot >= 0.8 * human,
@@ -667,5 +677,49 @@ fn every_shipped_robot_walks_the_smpl_walks_in_both_solves() {
                 }
             }
         }
+    }
+}
+
+/// Issue 43: every shipped robot (the ten of GMR's keys we can redistribute) under the first
+/// 300 frames of the LAFAN1 walk with no config (the derived one), the default solve, with its
+/// joint speed limits: upright, facing, feet alternating, no joint outside its range, no
+/// sole below the floor by more than the report's tolerance and no self-penetration deeper
+/// than the report's `self_collision_depth`, and no primitives of ours touching at `qpos0`
+/// (such pairs would be left out of the self-collision constraint unnoticed).
+#[test]
+fn every_shipped_robot_walks_the_lafan1_walk_with_no_config() {
+    let Some(bvh) = lafan_walk() else { return };
+    let bvh = first_frames(bvh, 300);
+    assert_eq!(retarget::shipped::ROBOTS.len(), 10);
+    for robot in retarget::shipped::ROBOTS {
+        let model = robot.model().unwrap();
+        let checks = run(&model, robot.key, &bvh, None);
+        assert_eq!(checks.choice, Choice::Derived, "{}", robot.key);
+        let report = checks.quality.clone().unwrap();
+        let (limits, ground, own) =
+            (&report.joint_limits, &report.ground_penetration, &report.self_collision);
+        assert_sane(&format!("walk → {}", robot.key), &checks, true);
+        println!(
+            "{}: limits {} violations (max {:.2e}); ground {:.1} % of frames, max {:.2} cm; \
+             self {} frames deep, {} penetrating, max {:.2} cm {:?}; pairs {} (at rest {}, \
+             adjacent {})",
+            robot.key,
+            limits.violations,
+            limits.max_excess,
+            100.0 * ground.duration,
+            ground.max_depth_cm,
+            own.frames_deep,
+            own.frames_penetrating,
+            own.max_depth_cm,
+            own.worst_pair,
+            own.pairs,
+            own.ignored_pairs,
+            own.adjacent_pairs,
+        );
+        assert_eq!(limits.violations, 0, "{}", robot.key);
+        assert_eq!(ground.duration, 0.0, "{}: sole below the floor", robot.key);
+        assert_eq!(own.frames_deep, 0, "{}: self-penetration {:?}", robot.key, own.worst_pair);
+        assert!(own.pairs > 0, "{}: no self-collision pairs checked", robot.key);
+        assert_eq!(own.ignored_pairs, 0, "{}: primitives touching at qpos0", robot.key);
     }
 }

@@ -34,7 +34,7 @@ fn g1_walk() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
     let walk = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh")?;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let model = mjcf::Model::from_file(&root.join("robots/unitree_g1/unitree_g1.xml")).unwrap();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let config = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let bvh = bvh::from_path(&walk).unwrap();
     let (human, report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
     Some((model, config, human, report.height))

@@ -88,7 +88,7 @@ fn lafan1_walk_on_g1_matches_gmr() {
         mjcf::Model::from_file(&shared.join("reference/robots/unitree_g1/g1_mocap_29dof.xml"))
             .unwrap();
     let shipped =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/bvh_lafan1_to_unitree_g1.json");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/gmr/bvh_lafan1_to_g1.json");
     let config = IkConfig::from_file(&shipped).unwrap();
     let gmr_config =
         IkConfig::from_file(&shared.join("reference/gmr_ik_configs/bvh_lafan1_to_g1.json"))

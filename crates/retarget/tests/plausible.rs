@@ -43,7 +43,7 @@ fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
 fn g1_jumps() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
     let path = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh")?;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let config = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let (full, report) =
         fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
     Some((g1(), config, full, report.height))
@@ -58,7 +58,7 @@ fn solve(
     let path = shared::shared_file(&format!("data/bvh/{take}"))?;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let model = g1();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let config = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let bvh = bvh::from_path(&path).unwrap();
     let (full, human_report) = fk::human_motion(&bvh, &fk::FkOptions::default()).unwrap();
     let human = slice(&full, range);
@@ -155,7 +155,7 @@ fn only_targets_that_disagree_with_the_legs_are_reweighed() {
     let bvh = first_frames(bvh::from_path(&path).unwrap(), 900);
     let model = g1();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let tuned = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let tuned = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let human = retarget::derive::human_body(&bvh, &fk::FkOptions::default(), "walk").unwrap();
     let roles = retarget::RobotRoles::recognise(&model).unwrap();
     let derived = retarget::derive::derive(&model, &roles, &human, "derived").unwrap();

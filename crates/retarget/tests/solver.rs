@@ -160,30 +160,23 @@ fn lafan1_bodies() -> Option<Vec<String>> {
 #[test]
 fn every_shipped_config_fits_its_robot_and_lafan1() {
     let Some(human) = lafan1_bodies() else { return };
-    let dir = repo().join("configs");
     let mut count = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        let Some(key) = name.strip_prefix("bvh_lafan1_to_").and_then(|n| n.strip_suffix(".json"))
-        else {
-            continue;
-        };
+    for config in retarget::shipped::CONFIGS.iter().filter(|c| c.source == "bvh_lafan1") {
+        let key = config.robot;
         let model_path = repo().join(format!("robots/{key}/{key}.xml"));
         let model = Model::from_file(&model_path).unwrap_or_else(|e| panic!("{key}: {e}"));
-        let config = IkConfig::from_file(&path).unwrap();
-        config.validate(&model, &human).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let parsed = IkConfig::from_file(&repo().join(config.path)).unwrap();
+        parsed.validate(&model, &human).unwrap_or_else(|e| panic!("{}: {e}", config.path));
         count += 1;
     }
-    assert!(count >= 6, "only {count} shipped configs");
+    assert!(count >= 8, "only {count} shipped configs");
 }
 
 #[test]
 fn unknown_names_are_located_with_suggestions() {
     let Some(human) = lafan1_bodies() else { return };
     let model = g1();
-    let text =
-        std::fs::read_to_string(repo().join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let text = std::fs::read_to_string(repo().join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let bad = text.replace("\"left_knee_link\"", "\"left_kne_link\"");
     let config = IkConfig::from_json_str(&bad, "g1.json").unwrap();
     let err = config.validate(&model, &human).unwrap_err().to_string();

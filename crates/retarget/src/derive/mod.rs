@@ -6,7 +6,7 @@
 //! hand; the head is not tracked, as in GMR's configs):
 //!
 //! - **Body ↔ joint**: the role's robot body tracks the role's human joint.
-//! - **Weights**: GMR's tuned G1 config (`configs/bvh_lafan1_to_unitree_g1.json`), per part,
+//! - **Weights**: GMR's tuned G1 config (`configs/gmr/bvh_lafan1_to_g1.json`), per part,
 //!   except the feet's position weight and the upper arm's rotation weight in table 2,
 //!   which are those of GMR's configs for the T1, N1, PM01 and ToddlerBot (the G1's and the
 //!   H1's have 50 on the feet and 100 on the upper arms' rotation in both tables):
