@@ -79,7 +79,8 @@ def load_bvh_file(bvh_file: "os.PathLike[str] | str", format: str = "lafan1") ->
     (the foot's position with the toe's orientation; the toe is ``LeftToe`` for
     ``format="lafan1"``, ``LeftToeBase`` for ``"nokov"``). Positions are metres (the file in
     centimetres) with Z up (the file's Y up turned +90° about X), orientations w x y z.
-    ``human_height`` is GMR's constant 1.75.
+    ``human_height`` is GMR's constant 1.75. ``format="soma"`` is GMR pull request #169's SOMA
+    loader (BONES-SEED; not merged in GMR): no foot bodies, turned to face +X, 1.70 m.
     """
     return _native.load_bvh_gmr(os.fspath(bvh_file), format)
 

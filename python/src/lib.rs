@@ -637,7 +637,8 @@ impl Motion {
 }
 
 /// GMR's ``load_bvh_file``: frames of ``{body: [position, wxyz quaternion]}`` (joints, no End
-/// Sites, then ``LeftFootMod``/``RightFootMod``; metres, Z up) and GMR's height 1.75 m.
+/// Sites, then ``LeftFootMod``/``RightFootMod``; metres, Z up) and GMR's height for the format
+/// (1.75 m; ``"soma"``, GMR PR #169's loader: 1.70 m).
 #[pyfunction]
 #[pyo3(signature = (path, format="lafan1"))]
 fn load_bvh_gmr<'py>(
@@ -666,7 +667,7 @@ fn load_bvh_gmr<'py>(
         }
         frames.append(frame)?;
     }
-    Ok((frames, retarget::GMR_HUMAN_HEIGHT))
+    Ok((frames, format.human_height()))
 }
 
 /// A take given as a name (``str``) or an index (``int``).

@@ -44,6 +44,16 @@ def test_loader_returns_what_gmrs_returns(loaded):
         load_bvh_file("whatever.bvh", format="fbx")
 
 
+def test_soma_loader_is_gmr_pr169s(shared):
+    # GMR pull request #169's SOMA loader (BONES-SEED; not merged in GMR): 1.70 m, no foot bodies.
+    frames, height = load_bvh_file(shared / "data/soma/Neutral_walk_forward_002__A057.bvh", format="soma")
+    assert height == 1.70 and len(frames) == 1088
+    names = list(frames[0])
+    assert "LeftFootMod" not in names and "LeftShin" in names and names[0] == "Root"
+    hips, foot = frames[0]["Hips"][0], frames[0]["LeftFoot"][0]
+    assert 0.7 < hips[2] - foot[2] < 1.1  # metres, Z up
+
+
 def test_retarget_reproduces_gmrs_output(loaded, reference):
     frames, height = loaded
     gmr = GMR(src_human="bvh_lafan1", tgt_robot="unitree_g1", actual_human_height=height)

@@ -31,13 +31,14 @@ pub enum BvhFormat {
 }
 
 impl BvhFormat {
-    /// GMR master's names, `"lafan1"` and `"nokov"`. Not PR #169's `"soma"`: the Python
-    /// binding returns [`HUMAN_HEIGHT`] for every format, not [`BvhFormat::human_height`].
+    /// GMR master's names, `"lafan1"` and `"nokov"`, and GMR PR #169's `"soma"` (unmerged in
+    /// GMR).
     #[must_use]
     pub fn from_name(name: &str) -> Option<BvhFormat> {
         match name {
             "lafan1" => Some(BvhFormat::Lafan1),
             "nokov" => Some(BvhFormat::Nokov),
+            "soma" => Some(BvhFormat::Soma),
             _ => None,
         }
     }
