@@ -3,7 +3,7 @@
 // Indexing: per-frame diagnostics hold one entry per tracked body, as `body_names` does.
 #![allow(clippy::indexing_slicing)]
 
-use crate::solver::{FrameDiagnostics, SolverOptions};
+use crate::ik::{FrameDiagnostics, SolverOptions};
 use fk::FkOptions;
 use std::collections::BTreeMap;
 

@@ -41,8 +41,8 @@ use nalgebra::DVectorView;
 
 use super::banded::Banded;
 use super::dynamics::{Centroidal, DynamicsOptions, FrameState};
+use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
-use crate::solver::{FrameDiagnostics, Solver};
 use crate::Error;
 
 /// Tunables of the trajectory solve.
