@@ -160,7 +160,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 mod dynamics;
-mod feet;
+mod foot_metrics;
 mod rates;
 mod text;
 mod verdict;
@@ -173,7 +173,7 @@ use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
 use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses};
 use crate::Error;
-use feet::{floating, foot_heights, foot_report, skating, stance};
+use foot_metrics::{floating, foot_heights, foot_report, skating, stance};
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]

@@ -12,7 +12,7 @@ use std::ops::Range;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::math::{quat, wrap};
-use super::options::Anchor;
+use super::plan_options::Anchor;
 use super::soles::RobotFoot;
 use crate::contact::phases;
 use crate::lie::Pose;

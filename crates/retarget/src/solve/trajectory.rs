@@ -40,7 +40,7 @@ use mjcf::{Data, JointType, Model};
 use nalgebra::DVectorView;
 
 use super::banded::Banded;
-use super::dynamics::{Centroidal, DynamicsOptions, FrameState};
+use super::dynamics_term::{Centroidal, DynamicsOptions, FrameState};
 use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::Error;
