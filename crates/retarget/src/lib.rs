@@ -96,7 +96,7 @@
 mod centroidal;
 mod config;
 mod constraints;
-mod contact;
+mod contact_phases;
 pub mod derive;
 mod error;
 mod fbx_clip;
@@ -124,7 +124,7 @@ pub mod writers;
 pub use retargeter::{FileResult, HumanFrame, Retargeter};
 
 // The options: what a user sets.
-pub use contact::ContactOptions;
+pub use contact_phases::ContactOptions;
 pub use feet::{Anchor, FootPlanOptions};
 pub use ik::{Arithmetic, SolverOptions};
 pub use solve::trajectory::Objective;

@@ -4,7 +4,7 @@
 //! | # | stage | file | what it does | options |
 //! |---|---|---|---|---|
 //! | 1 | targets | `prepare.rs` | the config's IK targets of every frame (GMR's scaling and offsets), the tasks | [`RetargetOptions`] |
-//! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact::ContactOptions`] |
+//! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact_phases::ContactOptions`] |
 //! | 3 | foot plan | `footholds.rs` | the robot's feet planted on them: anchors, soles standing flat, swing floors | [`crate::feet::FootPlanOptions`] |
 //! | 4 | reweighing | `reweigh.rs` | trunk and leg weights where the config's pelvis disagrees with the robot's legs | [`PlausibleOptions`] |
 //! | 5 | first pass | `first_pass.rs` | every frame solved causally with the hard constraints (what streams run) | [`crate::SolverOptions`] |
