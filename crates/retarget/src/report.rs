@@ -418,7 +418,7 @@ pub struct Stance {
 
 /// Joint speeds against the joints' published limits.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct JointSpeedLimits {
+pub struct JointSpeedReport {
     /// Joints with a limit.
     pub joints: usize,
     /// Frames × joints over their limit.
@@ -451,7 +451,7 @@ pub struct QualityReport {
     /// `None` without the source's foot contacts.
     pub stance: Option<Stance>,
     /// `None` when no joint has a published speed limit.
-    pub joint_speed: Option<JointSpeedLimits>,
+    pub joint_speed: Option<JointSpeedReport>,
     /// The root's acceleration, and its target's.
     pub root_acceleration: RootAcceleration,
     /// Mean `|q̈|` over every velocity coordinate, the root's included.
@@ -643,15 +643,15 @@ fn collisions(
     (ground, own, self_depth)
 }
 
-fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedLimits> {
-    let mut out: Option<JointSpeedLimits> = None;
+fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedReport> {
+    let mut out: Option<JointSpeedReport> = None;
     for (j, a) in scalar_joints(model) {
         let Some(limit) = model.joints[j].velocity_limit.filter(|l| *l > 0.0) else { continue };
         let q: Vec<f64> = (0..motion.num_frames()).map(|t| motion.frame(t)[a]).collect();
         let speed = gradient_rows(&q, 1, 1.0 / motion.fps);
         let over = speed.iter().filter(|v| v.abs() > limit).count();
         let ratio = speed.iter().fold(0.0f64, |m, v| m.max(v.abs() / limit));
-        let entry = out.get_or_insert_with(|| JointSpeedLimits {
+        let entry = out.get_or_insert_with(|| JointSpeedReport {
             joints: 0,
             violations: 0,
             worst_ratio: 0.0,
