@@ -26,7 +26,7 @@ pub struct StepContext<'a> {
     pub data: &'a Data,
     pub qpos: &'a [f64],
     /// Geoms held higher than the floor in this frame, with the height each keeps above it
-    /// (a swing foot's sole, [`crate::solver::Solver::set_raised_geoms`]), sorted by geom.
+    /// (a swing foot's sole, [`crate::ik::Solver::set_raised_geoms`]), sorted by geom.
     pub raised: &'a [(usize, f64)],
 }
 

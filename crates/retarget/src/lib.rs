@@ -96,13 +96,14 @@
 mod centroidal;
 mod config;
 mod constraints;
-mod contact;
+mod contact_phases;
 pub mod derive;
 mod error;
 mod fbx_clip;
 mod feet;
 mod follow;
 mod gmr;
+mod ik;
 mod joint_speed;
 mod lie;
 mod marker_config;
@@ -116,7 +117,6 @@ mod robot_roles;
 pub mod shipped;
 mod smpl;
 mod solve;
-mod solver;
 mod targets;
 pub mod writers;
 
@@ -124,14 +124,14 @@ pub mod writers;
 pub use retargeter::{FileResult, HumanFrame, Retargeter};
 
 // The options: what a user sets.
-pub use contact::ContactOptions;
+pub use contact_phases::ContactOptions;
 pub use feet::{Anchor, FootPlanOptions};
+pub use ik::{Arithmetic, SolverOptions};
 pub use solve::trajectory::Objective;
 pub use solve::{
     ChunkOptions, DynamicsOptions, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode,
     SolveMode, SpeedLimits, TrajectoryOptions,
 };
-pub use solver::{Arithmetic, SolverOptions};
 
 // The inputs besides the human motion: IK and marker configs, FBX clips, robot roles.
 pub use config::{IkConfig, MatchEntry};
@@ -141,10 +141,10 @@ pub use robot_roles::{RobotRole, RobotRoles, Sole};
 
 // The outputs.
 pub use follow::{blocked_limbs, Blocked as BlockedLimb, PinnedJoint};
+pub use ik::FrameDiagnostics;
 pub use motion::{FootContacts, RobotMotion, TrackedTargets};
 pub use resample::resample;
 pub use solve::{ClipDiagnostics, StageReport, StageValue};
-pub use solver::FrameDiagnostics;
 
 // GMR's BVH loader, for code written against GMR.
 pub use gmr::{
@@ -159,6 +159,7 @@ pub use error::Error;
 pub mod internals {
     pub use crate::constraints::{Constraint, Ground, SelfCollision, StepContext};
     pub use crate::feet::detect_feet;
+    pub use crate::ik::{PointTask, Solver, TaskSpec};
     pub use crate::joint_speed::JointSpeedLimits;
     pub use crate::lie::{mat_to_quat, Pose};
     pub use crate::marker_config::labelled_points;
@@ -166,6 +167,5 @@ pub mod internals {
     pub use crate::smpl::{frames_from, GMR_FIRST_FRAME};
     pub use crate::solve::banded::{Banded, NotPositiveDefinite};
     pub use crate::solve::{retarget_bvh, retarget_motion, retarget_motion_chunked, task_specs};
-    pub use crate::solver::{PointTask, Solver, TaskSpec};
     pub use crate::targets::{ScaledBody, TargetMap};
 }

@@ -99,7 +99,7 @@
 //!   (every other coordinate), and **all** nv coordinates together (units mixed). The
 //!   per-joint `jitter` above stays as it was (hinge and slide joints only).
 //! - **Dynamics check** ([`Dynamics`], per frame [`FrameDynamics`], [`dynamics_frames`];
-//!   tunables [`DynamicsOptions`]): inverse dynamics of the floating base at the centroidal
+//!   tunables [`DynamicsCheckOptions`]): inverse dynamics of the floating base at the centroidal
 //!   level. Mass model: every body's [`mjcf::Body::inertial`] (mass `m_i`, centre of mass
 //!   `x_i`, principal inertia `I_i` in the frame `R_i`); a body without inertial and without
 //!   geoms is massless, as in MuJoCo; one with geoms but no inertial (MuJoCo would take its
@@ -121,20 +121,21 @@
 //!     `conaffinity`): a sphere's bottom, a capsule's bottom at each end, a box's eight
 //!     corners, a cylinder's lowest rim point and four rim points (along its x and y) on each
 //!     cap, an ellipsoid's bottom. A point is a contact at frame t when it is within
-//!     [`DynamicsOptions::contact_height`] (1 cm) of the floor (`z − ground < 1 cm`, below
+//!     [`DynamicsCheckOptions::contact_height`] (1 cm) of the floor (`z − ground < 1 cm`, below
 //!     included) at t−1, t or t+1, the frames whose accelerations the average reads (a foot
 //!     that leaves the floor at t pushed in the averaged rate); its position is the one at t.
 //!   - *Forces*: at each contact point a force in the pyramid of
-//!     [`DynamicsOptions::cone_edges`] (8) edges inscribed in the friction cone
-//!     `|f_t| ≤ μ f_z`, μ = [`DynamicsOptions::friction`] (0.8): `f = Σ_j λ_j d_j`, `λ_j ≥ 0`,
-//!     `d_j ∝ (μ cos 2πj/8, μ sin 2πj/8, 1)` (tangential friction at least `μ cos(π/8) =
-//!     0.92 μ` in every direction). The `λ` minimise the residual `‖W_n − Σ λ_j A_j‖` in the
-//!     normalised units below (non-negative least squares, Lawson–Hanson).
+//!     [`DynamicsCheckOptions::cone_edges`] (8) edges inscribed in the friction cone
+//!     `|f_t| ≤ μ f_z`, μ = [`DynamicsCheckOptions::friction`] (0.8): `f = Σ_j λ_j d_j`,
+//!     `λ_j ≥ 0`, `d_j ∝ (μ cos 2πj/8, μ sin 2πj/8, 1)` (tangential friction at least
+//!     `μ cos(π/8) = 0.92 μ` in every direction). The `λ` minimise the residual
+//!     `‖W_n − Σ λ_j A_j‖` in the normalised units below (non-negative least squares,
+//!     Lawson–Hanson).
 //!   - *Residual* (m·g): force part `|F_res| / (m g)`, torque part (about `c`)
 //!     `|τ_res| / (m g L)` with `L` ([`Dynamics::lever_m`]) the height of the centre of mass
 //!     above the lowest collision point at `qpos0` (the robot standing; 1 m where that is not
 //!     positive; G1 0.71 m, T1 0.63 m); the residual is `√(force² + torque²)`. Reported: its mean, p95
-//!     and max over checked frames, the frames over [`DynamicsOptions::threshold`] (0.1 m·g)
+//!     and max over checked frames, the frames over [`DynamicsCheckOptions::threshold`] (0.1 m·g)
 //!     and their share, the same over support frames (with a contact) alone.
 //!   - *Centre of pressure*: in a support frame whose needed force pushes up by the threshold
 //!     or more (`F_z ≥ 0.1 m g`; as `F_z` goes to 0 the point runs off to infinity),
@@ -142,7 +143,7 @@
 //!     `τ + (c − p) × F` has no horizontal part) and its distance outside the convex hull of
 //!     the contact points seen from above (a segment or a point with fewer; 0 inside); mean,
 //!     p95, max (cm) and the frames outside by more than
-//!     [`DynamicsOptions::cop_tolerance`] (1 cm).
+//!     [`DynamicsCheckOptions::cop_tolerance`] (1 cm).
 //!   - *Flight*: checked frames without any contact point. The needed wrench is all residual
 //!     (a ballistic centre of mass and a constant `L_c` need none): mean, p95, max (m·g), the
 //!     frames over the threshold and their share.
@@ -160,12 +161,14 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 mod dynamics;
-mod feet;
+mod foot_metrics;
 mod rates;
 mod text;
 mod verdict;
 
-pub use dynamics::{half_step, CentreOfPressure, Dynamics, DynamicsOptions, Flight, FrameDynamics};
+pub use dynamics::{
+    half_step, CentreOfPressure, Dynamics, DynamicsCheckOptions, Flight, FrameDynamics,
+};
 pub use rates::{AccelStats, AveragedAcceleration, Jitter, RootAcceleration, GRAVITY};
 pub use verdict::{Caps, Check, GmrCaps, Verdict};
 
@@ -173,7 +176,7 @@ use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
 use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses};
 use crate::Error;
-use feet::{floating, foot_heights, foot_report, skating, stance};
+use foot_metrics::{floating, foot_heights, foot_report, skating, stance};
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]
@@ -221,7 +224,7 @@ pub struct ReportOptions {
     /// derived ones begin their match table with the root).
     pub root_target: Option<String>,
     /// The dynamics check's contacts, friction, thresholds and averaging time.
-    pub dynamics: DynamicsOptions,
+    pub dynamics: DynamicsCheckOptions,
     /// The verdict's caps.
     pub caps: Caps,
 }
@@ -244,7 +247,7 @@ impl Default for ReportOptions {
             self_collision_depth: 0.01,
             position_targets: None,
             root_target: None,
-            dynamics: DynamicsOptions::default(),
+            dynamics: DynamicsCheckOptions::default(),
             caps: Caps::default(),
         }
     }
@@ -418,7 +421,7 @@ pub struct Stance {
 
 /// Joint speeds against the joints' published limits.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct JointSpeedLimits {
+pub struct JointSpeedReport {
     /// Joints with a limit.
     pub joints: usize,
     /// Frames × joints over their limit.
@@ -451,12 +454,12 @@ pub struct QualityReport {
     /// `None` without the source's foot contacts.
     pub stance: Option<Stance>,
     /// `None` when no joint has a published speed limit.
-    pub joint_speed: Option<JointSpeedLimits>,
+    pub joint_speed: Option<JointSpeedReport>,
     /// The root's acceleration, and its target's.
     pub root_acceleration: RootAcceleration,
     /// Mean `|q̈|` over every velocity coordinate, the root's included.
     pub jitter: Jitter,
-    /// The dynamics check, accelerations averaged over [`DynamicsOptions::span`]; `None`
+    /// The dynamics check, accelerations averaged over [`DynamicsCheckOptions::span`]; `None`
     /// when the model's masses are not known or the clip is shorter than the span
     /// ([`QualityReport::dynamics_unavailable`] says why).
     pub dynamics: Option<Dynamics>,
@@ -565,7 +568,7 @@ pub fn report(
 }
 
 /// The dynamics check of every checked frame (frames 2h..T−1−2h, accelerations averaged over
-/// [`DynamicsOptions::span`]; module documentation), e.g. to find the frames behind
+/// [`DynamicsCheckOptions::span`]; module documentation), e.g. to find the frames behind
 /// [`QualityReport::dynamics`]. An [`Error::Options`] when the model's masses are not known.
 pub fn dynamics_frames(
     motion: &RobotMotion,
@@ -643,15 +646,15 @@ fn collisions(
     (ground, own, self_depth)
 }
 
-fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedLimits> {
-    let mut out: Option<JointSpeedLimits> = None;
+fn joint_speed(motion: &RobotMotion, model: &mjcf::Model) -> Option<JointSpeedReport> {
+    let mut out: Option<JointSpeedReport> = None;
     for (j, a) in scalar_joints(model) {
         let Some(limit) = model.joints[j].velocity_limit.filter(|l| *l > 0.0) else { continue };
         let q: Vec<f64> = (0..motion.num_frames()).map(|t| motion.frame(t)[a]).collect();
         let speed = gradient_rows(&q, 1, 1.0 / motion.fps);
         let over = speed.iter().filter(|v| v.abs() > limit).count();
         let ratio = speed.iter().fold(0.0f64, |m, v| m.max(v.abs() / limit));
-        let entry = out.get_or_insert_with(|| JointSpeedLimits {
+        let entry = out.get_or_insert_with(|| JointSpeedReport {
             joints: 0,
             violations: 0,
             worst_ratio: 0.0,

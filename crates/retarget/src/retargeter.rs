@@ -32,6 +32,7 @@ use nalgebra::{Isometry3, Quaternion, UnitQuaternion, Vector3};
 use crate::config::IkConfig;
 use crate::derive::Chosen;
 use crate::fbx_clip::FbxClip;
+use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
@@ -40,7 +41,6 @@ use crate::solve::{
     build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, PlausibleOptions,
     RetargetOptions, SolveMode,
 };
-use crate::solver::{FrameDiagnostics, Solver};
 use crate::targets::TargetMap;
 use crate::writers::Format;
 use crate::{shipped, Error};

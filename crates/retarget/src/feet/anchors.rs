@@ -12,9 +12,9 @@ use std::ops::Range;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::math::{quat, wrap};
-use super::options::Anchor;
+use super::plan_options::Anchor;
 use super::soles::RobotFoot;
-use crate::contact::phases;
+use crate::contact_phases::phases;
 use crate::lie::Pose;
 
 /// A stance phase (frames) with its anchor: the flat foot's horizontal position and yaw.

@@ -49,8 +49,9 @@
 //! One file per concept: `detect.rs` which bodies are the feet ([`detect_feet`]), `soles.rs`
 //! the robot foot and its sole ([`RobotFoot`], [`SolePoint`]: every collision primitive on the
 //! foot body and its descendants; `inertia.rs` the sole of a foot without collision geometry),
-//! `floor.rs` step 1, `anchors.rs` and `stance.rs` step 2, `swing.rs` step 3, `uncross.rs`
-//! crossed stances ([`Crossing`]); this file holds the options and the plan, in order.
+//! `floor.rs` step 1, `anchors.rs` and `stance.rs` step 2, `swing.rs` step 3, `crossings.rs`
+//! crossed stances ([`Crossing`]), `plan_options.rs` the tunables ([`FootPlanOptions`]); this
+//! file holds the plan, in order.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact
@@ -58,31 +59,31 @@
 #![allow(clippy::indexing_slicing)]
 
 mod anchors;
+mod crossings;
 mod detect;
 mod floor;
 mod inertia;
 mod math;
-mod options;
+mod plan_options;
 mod soles;
 mod stance;
 mod swing;
-mod uncross;
 
 use crate::lie::Pose;
 use crate::motion::FootContacts;
 use anchors::{foot_anchors, separate, Planted};
+use crossings::uncrossed;
 use floor::{floor_shift, keep_feet_apart};
 use math::quat;
 use stance::{plant, roll_shares};
 use swing::{swing, Swing};
-use uncross::uncrossed;
 
+pub use crossings::{Crossing, Uncrossing};
 pub use detect::detect_feet;
 pub(crate) use inertia::inertia_sole;
 pub(crate) use math::wrap;
-pub use options::{Anchor, FootPlanOptions};
+pub use plan_options::{Anchor, FootPlanOptions};
 pub use soles::{RobotFoot, SolePoint};
-pub use uncross::{Crossing, Uncrossing};
 
 /// What [`plan`] did: the vertical shift and per frame the weight factor of each foot.
 #[derive(Debug, Clone, PartialEq)]

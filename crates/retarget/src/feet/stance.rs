@@ -15,7 +15,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use super::anchors::{anchored, pivot, turn_of, Planted};
 use super::math::{quat, smoothstep, wrap};
-use super::options::FootPlanOptions;
+use super::plan_options::FootPlanOptions;
 use super::soles::{RobotFoot, CONTACT_PATCH};
 use crate::lie::Pose;
 

@@ -10,7 +10,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use super::math::{quat, smoothstep};
-use super::options::FootPlanOptions;
+use super::plan_options::FootPlanOptions;
 use super::soles::{RobotFoot, SolePoint};
 use crate::lie::Pose;
 

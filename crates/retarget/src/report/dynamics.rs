@@ -19,7 +19,7 @@ use crate::writers::BodyPoses;
 /// Tunables of the dynamics check ([`super::ReportOptions::dynamics`]).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
-pub struct DynamicsOptions {
+pub struct DynamicsCheckOptions {
     /// A collision geom's bottom point within this height of the ground is a contact (m).
     /// Default 0.01.
     pub contact_height: f64,
@@ -40,7 +40,7 @@ pub struct DynamicsOptions {
 }
 
 /// The half step `h` (frames) of the averaged accelerations at `fps` over `span` seconds
-/// ([`DynamicsOptions::span`]): `max(1, round(fps · span / 4))`.
+/// ([`DynamicsCheckOptions::span`]): `max(1, round(fps · span / 4))`.
 #[must_use]
 pub fn half_step(fps: f64, span: f64) -> usize {
     let h = (fps * span / 4.0).round();
@@ -51,9 +51,9 @@ pub fn half_step(fps: f64, span: f64) -> usize {
     }
 }
 
-impl Default for DynamicsOptions {
+impl Default for DynamicsCheckOptions {
     fn default() -> Self {
-        DynamicsOptions {
+        DynamicsCheckOptions {
             contact_height: 0.01,
             friction: 0.8,
             cone_edges: 8,
@@ -93,7 +93,7 @@ pub struct CentreOfPressure {
     pub frames: usize,
     /// Distance outside the support polygon (cm; 0 inside).
     pub outside_cm: Stats,
-    /// [`DynamicsOptions::cop_tolerance`] (cm).
+    /// [`DynamicsCheckOptions::cop_tolerance`] (cm).
     pub tolerance_cm: f64,
     /// Frames with the CoP outside by more than the tolerance, and their share of `frames`.
     pub frames_outside: usize,
@@ -106,7 +106,7 @@ pub struct Flight {
     pub frames: usize,
     /// The needed wrench, which is all residual (m·g).
     pub residual_mg: Stats,
-    /// Flight frames over [`DynamicsOptions::threshold`], and their share of `frames`.
+    /// Flight frames over [`DynamicsCheckOptions::threshold`], and their share of `frames`.
     pub frames_over: usize,
     pub share_over: f64,
 }
@@ -121,9 +121,9 @@ pub struct Dynamics {
     pub lever_m: f64,
     pub friction: f64,
     pub cone_edges: usize,
-    /// [`DynamicsOptions::contact_height`] (cm).
+    /// [`DynamicsCheckOptions::contact_height`] (cm).
     pub contact_height_cm: f64,
-    /// [`DynamicsOptions::threshold`] (m·g).
+    /// [`DynamicsCheckOptions::threshold`] (m·g).
     pub threshold_mg: f64,
     /// The half step `h` of the averaged accelerations (frames; [`half_step`]) and the time
     /// they read, `4h / fps` (s): 1 and 0.133 s at 30 fps, 5 and 0.167 s at 120 fps.
@@ -225,14 +225,14 @@ pub(super) struct Checked {
 
 /// Per checked frame (2h ≤ t ≤ T − 1 − 2h), the dynamics check with accelerations averaged
 /// over the half step `h` (frames; `None`: [`half_step`] of the clip's rate and
-/// [`DynamicsOptions::span`]; `Some(1)`: the 5-frame figure); or why the model's masses are
+/// [`DynamicsCheckOptions::span`]; `Some(1)`: the 5-frame figure); or why the model's masses are
 /// not known. `ground` is the floor's height.
 pub(super) fn check(
     motion: &RobotMotion,
     model: &mjcf::Model,
     poses: &BodyPoses,
     ground: f64,
-    opts: &DynamicsOptions,
+    opts: &DynamicsCheckOptions,
     half: Option<usize>,
 ) -> Result<Checked, String> {
     let bodies = mass_bodies(model)?;
@@ -392,7 +392,7 @@ fn outside(hull: &[Vector2<f64>], p: &Vector2<f64>) -> f64 {
 }
 
 /// The dynamics section of the report from the per-frame checks.
-pub(super) fn summarise(checked: &Checked, opts: &DynamicsOptions) -> Dynamics {
+pub(super) fn summarise(checked: &Checked, opts: &DynamicsCheckOptions) -> Dynamics {
     let Checked { frames, mass, lever, half_step, fps } = checked;
     let (mass, lever) = (*mass, *lever);
     let pick = |f: fn(&FrameDynamics) -> f64, keep: fn(&FrameDynamics) -> bool| -> Vec<f64> {

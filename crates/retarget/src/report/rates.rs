@@ -45,12 +45,12 @@ pub struct RootAcceleration {
     /// The body of that target ([`super::ReportOptions::root_target`]).
     pub target_body: Option<String>,
     /// The same accelerations averaged over the dynamics check's time
-    /// ([`super::DynamicsOptions::span`]), so that a 120 fps clip is judged on its motion,
+    /// ([`super::DynamicsCheckOptions::span`]), so that a 120 fps clip is judged on its motion,
     /// not on the finite-difference noise of one frame's 8 ms.
     pub averaged: AveragedAcceleration,
 }
 
-/// Root accelerations averaged over about [`super::DynamicsOptions::span`]: at frame t,
+/// Root accelerations averaged over about [`super::DynamicsCheckOptions::span`]: at frame t,
 /// `|p[t+2h] − 2 p[t] + p[t−2h]| · fps² / (2h)²`, `h` the dynamics check's half step
 /// ([`super::half_step`]), over the frames `2h` away from the ends.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -17,8 +17,8 @@ use nalgebra::Vector3;
 use super::prepare::reject_divergence;
 use super::prepare::Prepared;
 use super::SolveMode;
+use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
-use crate::solver::{FrameDiagnostics, Solver};
 use crate::Error;
 
 impl<'a> Prepared<'a> {
@@ -296,7 +296,7 @@ fn splice_passes(
 mod tests {
     use super::super::prepare::diverged;
     use super::splice_passes;
-    use crate::solver::FrameDiagnostics;
+    use crate::ik::FrameDiagnostics;
 
     /// One coordinate per frame, and the frames' errors.
     fn pass(q: &[f64], errors: &[f64]) -> (Vec<f64>, Vec<FrameDiagnostics>) {

@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 use super::prepare::Prepared;
 use super::{Planting, PlausibleOptions, SolveMode};
 use crate::feet::RobotFoot;
-use crate::solver::{PointTask, Solver, TaskSpec};
+use crate::ik::{PointTask, Solver, TaskSpec};
 use crate::Error;
 
 impl<'a> Prepared<'a> {

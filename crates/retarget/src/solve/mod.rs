@@ -4,11 +4,11 @@
 //! | # | stage | file | what it does | options |
 //! |---|---|---|---|---|
 //! | 1 | targets | `prepare.rs` | the config's IK targets of every frame (GMR's scaling and offsets), the tasks | [`RetargetOptions`] |
-//! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact::ContactOptions`] |
+//! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact_phases::ContactOptions`] |
 //! | 3 | foot plan | `footholds.rs` | the robot's feet planted on them: anchors, soles standing flat, swing floors | [`crate::feet::FootPlanOptions`] |
 //! | 4 | reweighing | `reweigh.rs` | trunk and leg weights where the config's pelvis disagrees with the robot's legs | [`PlausibleOptions`] |
 //! | 5 | first pass | `first_pass.rs` | every frame solved causally with the hard constraints (what streams run) | [`crate::SolverOptions`] |
-//! | 6 | trajectory | `trajectory.rs`, `windows.rs`, `banded.rs`, `dynamics.rs` | every frame of a window at once: tracking, smooth accelerations of every coordinate, the wrench the feet cannot supply, every constraint | [`TrajectoryOptions`], [`DynamicsOptions`] |
+//! | 6 | trajectory | `trajectory.rs`, `windows.rs`, `banded.rs`, `dynamics_term.rs` | every frame of a window at once: tracking, smooth accelerations of every coordinate, the wrench the feet cannot supply, every constraint | [`TrajectoryOptions`], [`DynamicsOptions`] |
 //! | 7 | uncrossing | `uncross.rs` | crossed stances the robot could not stand in, planned side by side and solved again | [`PlausibleOptions::uncross_stuck`] |
 //!
 //! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
@@ -19,7 +19,7 @@
 
 pub(crate) mod banded;
 mod contacts;
-pub mod dynamics;
+pub mod dynamics_term;
 mod first_pass;
 mod footholds;
 mod options;
@@ -37,7 +37,7 @@ use bvh::Bvh;
 use fk::HumanMotion;
 use mjcf::Model;
 
-pub use dynamics::DynamicsOptions;
+pub use dynamics_term::DynamicsOptions;
 pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
     ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,

@@ -3,7 +3,7 @@
 // Indexing: per-frame diagnostics hold one entry per tracked body, as `body_names` does.
 #![allow(clippy::indexing_slicing)]
 
-use crate::solver::{FrameDiagnostics, SolverOptions};
+use crate::ik::{FrameDiagnostics, SolverOptions};
 use fk::FkOptions;
 use std::collections::BTreeMap;
 
@@ -34,7 +34,7 @@ pub struct PlausibleOptions {
     /// (this plans over the whole clip, so it needs the future). The phases themselves are
     /// detected and written in every mode.
     pub planting: Planting,
-    pub contact: crate::contact::ContactOptions,
+    pub contact: crate::contact_phases::ContactOptions,
     pub feet: crate::feet::FootPlanOptions,
     /// Every collision geom stays above this height (m): the floor, for the ground
     /// constraint.
@@ -120,7 +120,7 @@ impl Default for PlausibleOptions {
     fn default() -> Self {
         PlausibleOptions {
             planting: Planting::On,
-            contact: crate::contact::ContactOptions::default(),
+            contact: crate::contact_phases::ContactOptions::default(),
             feet: crate::feet::FootPlanOptions::default(),
             floor: 0.0,
             speed_limits: SpeedLimits::Robot,

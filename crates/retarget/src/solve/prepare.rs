@@ -16,9 +16,9 @@ use super::{
 use crate::config::IkConfig;
 use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
+use crate::ik::{FrameDiagnostics, Solver, TaskSpec};
 use crate::lie::Pose;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
-use crate::solver::{FrameDiagnostics, Solver, TaskSpec};
 use crate::targets::TargetMap;
 use crate::Error;
 use fk::HumanMotion;
@@ -253,7 +253,7 @@ pub(crate) fn build_solver<'m>(
     let mut solver_options = options.solver.clone();
     if let SolveMode::Plausible(p) = &options.mode {
         solver_options.max_extra_steps = p.max_extra_steps;
-        solver_options.arithmetic = crate::solver::Arithmetic::Lean;
+        solver_options.arithmetic = crate::ik::Arithmetic::Lean;
     }
     let mut solver = Solver::new(model, stages, solver_options)?;
     if let SolveMode::Plausible(p) = &options.mode {

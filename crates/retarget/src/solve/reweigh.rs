@@ -15,7 +15,7 @@ use mjcf::Model;
 
 use super::prepare::Prepared;
 use super::{PlausibleOptions, SolveMode, StageReport, StageValue};
-use crate::solver::TaskSpec;
+use crate::ik::TaskSpec;
 use crate::Error;
 
 impl<'a> Prepared<'a> {

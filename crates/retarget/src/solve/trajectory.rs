@@ -40,9 +40,9 @@ use mjcf::{Data, JointType, Model};
 use nalgebra::DVectorView;
 
 use super::banded::Banded;
-use super::dynamics::{Centroidal, DynamicsOptions, FrameState};
+use super::dynamics_term::{Centroidal, DynamicsOptions, FrameState};
+use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
-use crate::solver::{FrameDiagnostics, Solver};
 use crate::Error;
 
 /// Tunables of the trajectory solve.

@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use super::prepare::{Prepared, Solved};
 use super::{SolveMode, StageReport, StageValue};
-use crate::solver::FrameDiagnostics;
+use crate::ik::FrameDiagnostics;
 use crate::Error;
 
 /// A planted foot this far (m) from its target in a crossed stance is stuck there

@@ -7,7 +7,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use super::prepare::Prepared;
-use crate::solver::{FrameDiagnostics, Solver};
+use crate::ik::{FrameDiagnostics, Solver};
 use crate::Error;
 
 impl<'a> Prepared<'a> {

@@ -16,6 +16,10 @@
 //! step, then more while the unweighted error norm drops by more than the threshold, at
 //! most `max_extra_steps` more. The first frame starts from `qpos0`, every later one from
 //! the previous solution.
+//!
+//! This module is one frame's IK (the [`Solver`]: `bounds.rs` the step's bounds, `qp_step.rs`
+//! its QP, `trajectory_step.rs` what the trajectory solve asks of it); the stages that run it
+//! over a clip are [`crate::solve`].
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: buffers are sized from the model (`nq`, `nv`, bodies) in `Solver::new`, which checks
@@ -34,7 +38,7 @@ use crate::Error;
 
 mod bounds;
 mod qp_step;
-mod window;
+mod trajectory_step;
 
 /// Fraction of a joint speed limit the solver allows itself ([`Solver::set_speed_limits`]).
 const SPEED_MARGIN: f64 = 0.999;
