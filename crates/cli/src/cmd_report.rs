@@ -141,9 +141,10 @@ pub fn run(args: ReportArgs) -> anyhow::Result<ExitCode> {
 /// The robot name an .npz stores (`robot`); none for other files.
 fn stored_robot(path: &std::path::Path) -> anyhow::Result<Option<String>> {
     let mut head = [0u8; 2];
-    let is_zip = std::fs::File::open(path)
-        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
-        .is_ok_and(|()| head == *b"PK");
+    // A file that cannot be opened is said so (not "no robot name stored").
+    let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let is_zip =
+        std::io::Read::read_exact(&mut file, &mut head).is_ok_and(|()| head == *b"PK");
     Ok(if is_zip { read_npz_robot(path)? } else { None })
 }
 

@@ -365,8 +365,10 @@ fn report_prints_and_writes_the_motion_over_time_sections() {
     ]);
     let text = stdout(&out);
     for line in [
-        "root acceleration (pelvis): mean",
+        "verdict: ok (",
+        "root acceleration (pelvis, averaged over 0.133 s): mean",
         "  scaled human (target of pelvis): mean",
+        "  frame by frame: mean",
         "jitter mean |q̈| over all 35",
         "dynamics (34.4 kg",
     ] {
