@@ -528,7 +528,7 @@ fn the_same_walk_at_30_60_and_120_fps_gives_the_same_motion() {
     };
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let model = g1();
-    let config = IkConfig::from_file(&root.join("configs/bvh_lafan1_to_unitree_g1.json")).unwrap();
+    let config = IkConfig::from_file(&root.join("configs/gmr/bvh_lafan1_to_g1.json")).unwrap();
     let base = first_frames(bvh::from_path(&path).unwrap(), 601);
     let solve = |factor: usize| {
         let bvh = upsampled(base.clone(), factor);
