@@ -143,8 +143,7 @@ fn stored_robot(path: &std::path::Path) -> anyhow::Result<Option<String>> {
     let mut head = [0u8; 2];
     // A file that cannot be opened is said so (not "no robot name stored").
     let mut file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
-    let is_zip =
-        std::io::Read::read_exact(&mut file, &mut head).is_ok_and(|()| head == *b"PK");
+    let is_zip = std::io::Read::read_exact(&mut file, &mut head).is_ok_and(|()| head == *b"PK");
     Ok(if is_zip { read_npz_robot(path)? } else { None })
 }
 
