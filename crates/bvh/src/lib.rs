@@ -38,7 +38,7 @@ pub use summary::{Summary, SummaryJoint, Units};
 pub use warning::Warning;
 pub use write::{write, write_json};
 
-/// Parse BVH text held in a string (see [`parse`]).
+/// Parse BVH text held in a string (see [`parse()`]).
 #[allow(clippy::should_implement_trait)] // a free function, like `serde_json::from_str`
 pub fn from_str(text: &str) -> Result<Bvh, Error> {
     parse(text.as_bytes())

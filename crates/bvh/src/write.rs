@@ -1,4 +1,4 @@
-//! Writers: BVH text (round-trips bit-identically through [`crate::parse`]) and a streamed
+//! Writers: BVH text (round-trips bit-identically through [`crate::parse()`]) and a streamed
 //! JSON dump. Both walk the tree with an explicit stack and write motion row by row from
 //! the parsed matrix, so memory stays at the size of [`Motion::values`].
 
@@ -8,7 +8,7 @@ use crate::float::is_space;
 use crate::skeleton::{Bvh, Joint, JointKind, Motion};
 
 /// Write `bvh` as BVH text. Numbers use the shortest representation that parses back to the
-/// same `f64` (ryu), so `parse(write(b)) == b` for any `b` that [`crate::parse`] returned.
+/// same `f64` (ryu), so `parse(write(b)) == b` for any `b` that [`crate::parse()`] returned.
 ///
 /// End Sites are written as `End Site` (their names are not stored in BVH and come back as
 /// `<Parent>_End`). A data model that cannot be written faithfully (non-finite numbers,
@@ -89,7 +89,7 @@ fn write_joint_head(
 /// ```
 ///
 /// `type` is `ROOT`, `JOINT` or `End`; End Sites have no channels and an empty `motion`.
-/// Non-finite numbers (which [`crate::parse`] never returns) are written as `null`.
+/// Non-finite numbers (which [`crate::parse()`] never returns) are written as `null`.
 pub fn write_json(bvh: &Bvh, out: impl Write) -> io::Result<()> {
     let tree = Tree::new(bvh)?;
     let mut w = BufWriter::with_capacity(1 << 16, out);

@@ -9,7 +9,7 @@
 //! neither (`meshdir`, `strippath`, `discardvisual`, `usethread`, the deprecated
 //! `coordinate="local"`, ...; `coordinate="global"` is MuJoCo's error). Elements that would
 //! change a pose but are not implemented are an
-//! [`Error::Unsupported`](crate::Error::Unsupported).
+//! [`Error::Unsupported`].
 
 use std::collections::HashSet;
 

@@ -1,6 +1,6 @@
 //! Hard constraints of the IK step beyond joint ranges: each kind is one small type that
 //! adds its linearised rows `a · Δq ≥ b` to the step's QP ([`crate::qp::DenseQp`]) at the
-//! current configuration. The solver ([`crate::Solver::add_constraint`]) holds them in
+//! current configuration. The solver ([`crate::ik::Solver::add_constraint`]) holds them in
 //! every step; the next kind of constraint is one new type here.
 //!
 //! Linearisation: a point `p(q)` on body `B` moves by `J_p(q) Δq` to first order (`J_p`:

@@ -74,7 +74,7 @@
 //!   the robot's recognised [`RobotRoles`] ([`RobotRole`], [`Sole`]).
 //! - **Outputs**: [`RobotMotion`] (with its [`FootContacts`] and [`TrackedTargets`]),
 //!   [`ClipDiagnostics`] of [`FrameDiagnostics`] and [`StageReport`]s ([`StageValue`]),
-//!   [`resample`] to another frame rate, [`blocked_limbs`] ([`BlockedLimb`], [`PinnedJoint`]):
+//!   [`resample()`] to another frame rate, [`blocked_limbs`] ([`BlockedLimb`], [`PinnedJoint`]):
 //!   where a limb could not follow.
 //! - **GMR's BVH loader**, for code written against GMR: [`load_bvh_gmr`], [`GmrBvhFormat`],
 //!   [`GMR_HUMAN_HEIGHT`].

@@ -38,7 +38,7 @@ pub struct Uncrossing<'a> {
     pub heading: &'a [f64],
 }
 
-/// The crossed pairs of overlapping stance phases ([`Crossing`]), found after [`separate`];
+/// The crossed pairs of overlapping stance phases ([`Crossing`]), found after [`super::anchors::separate`];
 /// those listed in `uncross` are moved apart across the heading, half the way each,
 /// until the left footprint is `gap` to the left of the right one.
 pub(super) fn uncrossed(

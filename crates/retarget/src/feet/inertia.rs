@@ -36,7 +36,7 @@ impl InertiaSole {
 /// length ([`INERTIA_SOLE_HALF_LENGTH`] for its longest half side). The N1's foot gives
 /// 19 × 6.8 × 3.4 cm with its bottom 4.9 cm below the ankle axis; a real sole's mass sits
 /// higher than its middle (motors, ankle), so the box's bottom is a little above the real
-/// sole, which the floor shift of [`super::plan`] takes up. `None` when no body there has an
+/// sole, which the floor shift of `super::plan` takes up. `None` when no body there has an
 /// inertial.
 pub(crate) fn inertia_sole(model: &Model, sole_body: usize) -> Option<InertiaSole> {
     (0..model.bodies.len())

@@ -85,7 +85,7 @@ pub(crate) use math::wrap;
 pub use plan_options::{Anchor, FootPlanOptions};
 pub use soles::{RobotFoot, SolePoint};
 
-/// What [`plan`] did: the vertical shift and per frame the weight factor of each foot.
+/// What `plan` did: the vertical shift and per frame the weight factor of each foot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FootPlan {
     /// Added to every target's z (m).
@@ -116,7 +116,7 @@ pub fn plan(
     plan_uncrossing(feet, contacts, targets, slots, fps, options, &Uncrossing::default())
 }
 
-/// [`plan`], with the crossed stance phases `crossings.uncross` moved apart sideways until
+/// `plan`, with the crossed stance phases `crossings.uncross` moved apart sideways until
 /// they are no longer crossed and their soles are [`FootPlanOptions::sole_gap`] apart, half
 /// the way each. Crossed and apart are across the robot's heading
 /// ([`Uncrossing::heading`]).

@@ -1,4 +1,4 @@
-//! The solver as the trajectory solve sees it ([`crate::solve`]): a frame's objective with
+//! The solver as the trajectory solve sees it (`crate::solve`): a frame's objective with
 //! its neighbours' terms added (`set_extra`, `set_next`, `set_previous`), raised floors for
 //! swing soles, the objective's model and stiffness, its constraint rows, one step of the
 //! window's iteration and the frame's diagnostics.
@@ -12,7 +12,7 @@ impl<'m> Solver<'m> {
     /// The trajectory solve's term of the next steps: `½ Δqᵀ H Δq + cᵀ Δq` added to the
     /// objective (`h`: row-major `nv × nv`, its upper triangle read; `c`: `nv`), the terms of
     /// the trajectory's cost that involve this frame with its neighbours held
-    /// ([`crate::solve`]). Empty slices remove it.
+    /// (`crate::solve`). Empty slices remove it.
     pub fn set_extra(&mut self, h: &[f64], c: &[f64]) -> Result<(), Error> {
         let nv = self.model.nv;
         if h.is_empty() && c.is_empty() {

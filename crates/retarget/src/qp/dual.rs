@@ -145,15 +145,13 @@ impl DenseQp {
     }
 
     /// Declares that `h[i][j] ≠ 0` only when `i` and `j` are equal or one is an ancestor of
-    /// the other in the tree `parent` (parents have lower indices), as for [`BoxQp::set_tree`]:
+    /// the other in the tree `parent` (parents have lower indices), as for `BoxQp::set_tree`:
     /// true of a Hessian built from body Jacobians over MuJoCo's dof tree. The factorisation
     /// is then MuJoCo's `mj_factorI` (`H = Lᵀ D L` eliminating leaves first, no fill-in) and
     /// `J = L⁻¹ D^-½ Q` (`J Jᵀ = H⁻¹` for any orthogonal `Q`) is never formed: products with
     /// `L⁻¹ D^-½` are tree solves, and only `Q`, the identity until the Givens rotations of
     /// the active set touch its columns, is stored. Ignored unless `parent` has `n` entries,
     /// each lower than its index.
-    ///
-    /// [`BoxQp::set_tree`]: super::BoxQp::set_tree
     pub fn set_tree(&mut self, parent: &[Option<usize>]) {
         let n = self.n;
         let ok =

@@ -22,7 +22,7 @@ use crate::lie::Pose;
 use crate::Error;
 
 impl<'a> Prepared<'a> {
-    /// The first pass over frames `frames` (forward; with [`PlausibleOptions::both_ways`]
+    /// The first pass over frames `frames` (forward; with [`crate::PlausibleOptions::both_ways`]
     /// also backward, on a second thread of rayon's pool, and spliced).
     pub(super) fn first_pass(
         &self,

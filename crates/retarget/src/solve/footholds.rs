@@ -55,7 +55,7 @@ impl<'a> Prepared<'a> {
 
     /// [`Prepared::set_frame_tasks`]; with `at` (kinematics of the smoothed pose a repair
     /// starts from), also a vertical task, weighted as the contact points, that lifts each
-    /// swing sole found below its swing clearance ([`FootPlan::swing_floor`]) back up to it.
+    /// swing sole found below its swing clearance ([`crate::feet::FootPlan::swing_floor`]) back up to it.
     /// The smoothing filter pulls a swing foot towards its planted neighbours' height, the
     /// further the more passes it has: ToddlerBot's (8 passes) swung 2.6–2.9 cm up (median)
     /// in 1,500 of its LAFAN1 walk's frames, under the report's 3 cm contact height, and the

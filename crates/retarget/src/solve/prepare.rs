@@ -25,7 +25,7 @@ use fk::HumanMotion;
 
 /// One clip made ready to solve: every frame's targets (foot-planned in the default mode),
 /// the source's contacts and the task setup. Solving frame ranges of it independently is
-/// how [`crate::chunked`] parallelises a clip.
+/// how [`super::schedule`] parallelises a clip.
 pub(crate) struct Prepared<'a> {
     // (The stages' files read and write these fields.)
     pub(super) model: &'a Model,
@@ -299,7 +299,7 @@ pub(super) fn diverged(qpos: &[f64]) -> bool {
     qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
 }
 
-/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged](diverged).
+/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged].
 pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
     if diverged(qpos) {
         return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });

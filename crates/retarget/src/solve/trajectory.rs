@@ -19,7 +19,7 @@
 //! their bound, or past it) are held by a stiff penalty
 //! ([`TrajectoryOptions::active_penalty`]); then one sweep over the frames solves each
 //! frame's subproblem exactly, its neighbours held, every constraint a hard row of the frame's
-//! QP ([`crate::Solver::trajectory_step`]). The sweep makes the result feasible and finds the
+//! QP ([`crate::ik::Solver::trajectory_step`]). The sweep makes the result feasible and finds the
 //! constraints the next iteration holds; the banded step moves the whole window, which a
 //! sweep alone (block Gauss–Seidel in time) does only slowly where the smoothness outweighs
 //! the tracking: a step in the initial trajectory that it spreads over five frames is still

@@ -43,7 +43,7 @@ impl<'a> Prepared<'a> {
     /// the feet again with the stuck crossed stances uncrossed ([`Prepared::uncross_stuck`])
     /// and solves again the frames whose targets that changed, with
     /// [`RESOLVE_MARGIN_S`] either side and a lead-in of [`RESOLVE_LEAD_IN_S`], as a chunk
-    /// is solved ([`crate::chunked`]); the rest of the clip is kept.
+    /// is solved ([`super::schedule`]); the rest of the clip is kept.
     pub(crate) fn resolve_uncrossed(&mut self, solved: &mut Solved) -> Result<(), Error> {
         let Some(changed) = self.uncross_stuck(&solved.qpos, &solved.frames) else {
             return Ok(());
