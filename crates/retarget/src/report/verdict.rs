@@ -173,6 +173,13 @@ fn check(name: &'static str, ok: bool, value: f64, cap: f64, unit: &'static str)
     Check { name, ok: Some(ok), value, cap, unit, detail: String::new() }
 }
 
+impl Check {
+    /// The check with what was measured, in words.
+    fn because(self, detail: impl Into<String>) -> Check {
+        Check { detail: detail.into(), ..self }
+    }
+}
+
 fn unmeasured(name: &'static str, why: &str) -> Check {
     Check { name, ok: None, value: 0.0, cap: 0.0, unit: "", detail: why.to_owned() }
 }
@@ -223,107 +230,88 @@ pub(super) fn verdict(
     let mut checks = vec![
         {
             let g = &rep.ground_penetration;
-            let mut c = check("penetration", g.frames == 0, g.frames as f64, 0.0, "frames");
-            c.detail = format!(
+            check("penetration", g.frames == 0, g.frames as f64, 0.0, "frames").because(format!(
                 "frames with a collision geom deeper than {:.1} cm below the floor (deepest {:.2} cm)",
                 g.tolerance_cm, g.max_depth_cm
-            );
-            c
+            ))
         },
         {
             let s = &rep.self_collision;
-            let mut c =
-                check("self_collision", s.frames_deep == 0, s.frames_deep as f64, 0.0, "frames");
-            c.detail = format!(
+            check("self_collision", s.frames_deep == 0, s.frames_deep as f64, 0.0, "frames").because(format!(
                 "frames with two of the robot's geoms deeper than {:.1} cm into each other (deepest {:.2} cm)",
                 s.deep_cm, s.max_depth_cm
-            );
-            c
+            ))
         },
         {
             let worst = rep.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
-            let mut c = check(
+            check(
                 "floor_skating",
                 worst <= caps.floor_skating_share,
                 worst,
                 caps.floor_skating_share,
                 "share",
-            );
-            c.detail = "the worse foot's share of floor frames whose contact point slides".into();
-            c
+            ).because("the worse foot's share of floor frames whose contact point slides")
         },
         match &rep.stance {
             Some(s) => {
-                let mut c = check(
+                check(
                     "stance",
                     s.sole_in_band_share >= caps.sole_in_band_share,
                     s.sole_in_band_share,
                     caps.sole_in_band_share,
                     "share (at least)",
-                );
-                c.detail = "share of source-contact samples with the sole in its band".into();
-                c
+                ).because("share of source-contact samples with the sole in its band")
             }
             None => unmeasured("stance", "no source foot contacts in the motion"),
         },
         floating(rep, series, fps, caps),
         {
             let v = rep.joint_limits.violations;
-            let mut c = check("joint_limits", v == 0, v as f64, 0.0, "frames × joints");
-            c.detail = format!(
+            check("joint_limits", v == 0, v as f64, 0.0, "frames × joints").because(format!(
                 "joint samples past their range (largest excess {:.4})",
                 rep.joint_limits.max_excess
-            );
-            c
+            ))
         },
         if any_unlimited {
             let fastest = unlimited.iter().copied().fold(0.0, f64::max) * fps;
-            let mut c = check(
+            check(
                 "joint_jumps",
                 fastest <= caps.joint_jump_speed,
                 fastest,
                 caps.joint_jump_speed,
                 "rad/s",
-            );
-            c.detail =
-                "the fastest joint without a published speed limit between two consecutive frames"
-                    .into();
-            c
+            ).because("the fastest joint without a published speed limit between two consecutive frames")
         } else {
             unmeasured("joint_jumps", "every joint has a published speed limit (see joint_speed)")
         },
         match &rep.joint_speed {
             Some(s) => {
-                let mut c = check(
+                check(
                     "joint_speed",
                     s.violations == 0,
                     s.violations as f64,
                     0.0,
                     "frames × joints",
-                );
-                c.detail = format!(
+                ).because(format!(
                     "joint samples over their published speed limit (worst {:.2}× on {})",
                     s.worst_ratio, s.worst_joint
-                );
-                c
+                ))
             }
             None => unmeasured("joint_speed", "no joint has a published speed limit"),
         },
         root_acceleration(rep, caps),
         match &rep.dynamics {
             Some(d) => {
-                let mut c = check(
+                check(
                     "dynamics",
                     d.share_over <= caps.dynamics_share,
                     d.share_over,
                     caps.dynamics_share,
                     "share",
-                );
-                c.detail = format!(
+                ).because(format!(
                     "share of frames needing more than {} m·g of wrench the feet cannot supply (accelerations over {:.3} s)",
                     d.threshold_mg, d.window_s
-                );
-                c
+                ))
             }
             None => unmeasured(
                 "dynamics",
@@ -348,8 +336,7 @@ fn floating(rep: &QualityReport, series: &Series<'_>, fps: f64, caps: &Caps) -> 
     } else {
         (flight, caps.flight_s, "s")
     };
-    let mut c = check("floating", ok, value, cap, unit);
-    c.detail = match &rep.stance {
+    check("floating", ok, value, cap, unit).because(match &rep.stance {
         Some(_) => format!(
             "longest time with both feet above {:.0} cm: {flight:.2} s; source-contact samples floating: {:.1} %",
             h * 100.0,
@@ -359,8 +346,7 @@ fn floating(rep: &QualityReport, series: &Series<'_>, fps: f64, caps: &Caps) -> 
             "longest time with both feet above {:.0} cm: {flight:.2} s (no source contacts: floating in stance not measured)",
             h * 100.0
         ),
-    };
-    c
+    })
 }
 
 fn root_acceleration(rep: &QualityReport, caps: &Caps) -> Check {
@@ -370,28 +356,26 @@ fn root_acceleration(rep: &QualityReport, caps: &Caps) -> Check {
             let ratio = a.motion.mean_mps2 / human.mean_mps2.max(1e-12);
             let ok = ratio <= caps.root_acceleration_ratio
                 || a.motion.mean_mps2 < caps.root_acceleration_floor;
-            let mut c =
-                check("root_acceleration", ok, ratio, caps.root_acceleration_ratio, "× human");
-            c.detail = format!(
+            check("root_acceleration", ok, ratio, caps.root_acceleration_ratio, "× human").because(
+                format!(
                 "mean root acceleration {:.2} m/s² against the scaled human's {:.2} (over {:.3} s)",
                 a.motion.mean_mps2, human.mean_mps2, a.window_s
-            );
-            c
+            ),
+            )
         }
         None => {
             let share = a.motion.share_over;
-            let mut c = check(
+            check(
                 "root_acceleration",
                 share <= caps.root_over_2g_share,
                 share,
                 caps.root_over_2g_share,
                 "share",
-            );
-            c.detail = format!(
+            )
+            .because(format!(
                 "share of frames with the root accelerating over 2 g (over {:.3} s; no targets, so not against the human)",
                 a.window_s
-            );
-            c
+            ))
         }
     }
 }
@@ -410,24 +394,25 @@ fn gmr_checks(
     let [l, r] = series.feet;
     let off = longest_run(l.iter().zip(r).map(|(a, b)| a.min(*b) > g.floating_height));
     let (off_s, off_share) = (off as f64 / fps, ratio(off, frames));
-    let mut floating = check(
+    let floating = check(
         "gmr_floating",
         off_s < g.floating_s && off_share < g.floating_run_share,
         off_s,
         g.floating_s,
         "s",
-    );
-    floating.detail = format!(
+    ).because(format!(
         "longest run with both feet above {:.0} cm: {off_s:.2} s, {:.1} % of the clip (GMR: ≥ {} s or ≥ {:.0} %)",
         g.floating_height * 100.0,
         off_share * 100.0,
         g.floating_s,
         g.floating_run_share * 100.0
-    );
+    ));
     let past = ratio(excess.iter().filter(|e| **e > g.limit_excess).count(), frames);
-    let mut limits = check("gmr_joint_limits", past < g.limit_share, past, g.limit_share, "share");
-    limits.detail =
-        format!("share of frames with a joint past its range by more than {} rad", g.limit_excess);
+    let limits = check("gmr_joint_limits", past < g.limit_share, past, g.limit_share, "share")
+        .because(format!(
+            "share of frames with a joint past its range by more than {} rad",
+            g.limit_excess
+        ));
     let jumps = ratio(steps.iter().filter(|s| **s > g.jump).count(), steps.len());
     let largest = steps.iter().copied().fold(0.0, f64::max);
     let (value, cap, unit) = if largest >= g.severe_jump {
@@ -435,31 +420,28 @@ fn gmr_checks(
     } else {
         (jumps, g.jump_share, "share")
     };
-    let mut jump =
-        check("gmr_joint_jumps", jumps < g.jump_share && largest < g.severe_jump, value, cap, unit);
-    jump.detail = format!(
+    let jump = check("gmr_joint_jumps", jumps < g.jump_share && largest < g.severe_jump, value, cap, unit).because(format!(
         "{:.1} % of transitions with a joint moving more than {} rad, largest {largest:.3} rad (GMR: ≥ {:.0} % or ≥ {} rad once)",
         jumps * 100.0,
         g.jump,
         g.jump_share * 100.0,
         g.severe_jump
-    );
+    ));
     let deep = |d: &f64| *d >= g.collision_depth;
     let share = ratio(series.self_depth.iter().filter(|d| deep(d)).count(), frames);
     let run = longest_run(series.self_depth.iter().map(deep)) as f64 / fps;
-    let mut collision = check(
+    let collision = check(
         "gmr_self_collision",
         share < g.collision_share && run < g.collision_s,
         share,
         g.collision_share,
         "share",
-    );
-    collision.detail = format!(
+    ).because(format!(
         "{:.1} % of frames with two geoms {:.0} mm or more into each other, longest run {run:.2} s (GMR: ≥ {:.0} % or ≥ {} s)",
         share * 100.0,
         g.collision_depth * 1000.0,
         g.collision_share * 100.0,
         g.collision_s
-    );
+    ));
     vec![floating, limits, jump, collision]
 }
