@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use super::{scalar_joints, QualityReport};
+use super::{ratio, scalar_joints, QualityReport};
 use crate::motion::RobotMotion;
 
 /// The caps of [`Verdict`] ([`super::ReportOptions::caps`]). Every time is in seconds and
@@ -165,10 +165,6 @@ fn longest_run(mask: impl Iterator<Item = bool>) -> usize {
     best
 }
 
-fn ratio(a: usize, b: usize) -> f64 {
-    super::ratio(a, b)
-}
-
 fn check(name: &'static str, ok: bool, value: f64, cap: f64, unit: &'static str) -> Check {
     Check { name, ok: Some(ok), value, cap, unit, detail: String::new() }
 }
@@ -184,11 +180,16 @@ fn unmeasured(name: &'static str, why: &str) -> Check {
     Check { name, ok: None, value: 0.0, cap: 0.0, unit: "", detail: why.to_owned() }
 }
 
+/// Whether joint `j` has no published speed limit (the report's `joint_speed` skips it).
+fn unlimited(model: &mjcf::Model, j: usize) -> bool {
+    model.joints[j].velocity_limit.is_none_or(|l| l <= 0.0)
+}
+
 /// Per frame transition, the largest `|Δq|` of the hinge and slide joints, of those without
-/// a published speed limit when `unlimited`.
-fn joint_steps(motion: &RobotMotion, model: &mjcf::Model, unlimited: bool) -> Vec<f64> {
+/// a published speed limit when `only_unlimited`.
+fn joint_steps(motion: &RobotMotion, model: &mjcf::Model, only_unlimited: bool) -> Vec<f64> {
     let adr: Vec<usize> = scalar_joints(model)
-        .filter(|&(j, _)| !unlimited || model.joints[j].velocity_limit.is_none_or(|l| l <= 0.0))
+        .filter(|&(j, _)| !only_unlimited || unlimited(model, j))
         .map(|(_, a)| a)
         .collect();
     (1..motion.num_frames())
@@ -223,9 +224,8 @@ pub(super) fn verdict(
     let fps = motion.fps;
     let frames = motion.num_frames();
     let steps = joint_steps(motion, model, false);
-    let unlimited = joint_steps(motion, model, true);
-    let any_unlimited =
-        scalar_joints(model).any(|(j, _)| model.joints[j].velocity_limit.is_none_or(|l| l <= 0.0));
+    let unlimited_steps = joint_steps(motion, model, true);
+    let any_unlimited = scalar_joints(model).any(|(j, _)| unlimited(model, j));
     let excess = limit_excess(motion, model);
     let mut checks = vec![
         {
@@ -273,7 +273,7 @@ pub(super) fn verdict(
             ))
         },
         if any_unlimited {
-            let fastest = unlimited.iter().copied().fold(0.0, f64::max) * fps;
+            let fastest = unlimited_steps.iter().copied().fold(0.0, f64::max) * fps;
             check(
                 "joint_jumps",
                 fastest <= caps.joint_jump_speed,
@@ -356,12 +356,12 @@ fn root_acceleration(rep: &QualityReport, caps: &Caps) -> Check {
             let ratio = a.motion.mean_mps2 / human.mean_mps2.max(1e-12);
             let ok = ratio <= caps.root_acceleration_ratio
                 || a.motion.mean_mps2 < caps.root_acceleration_floor;
-            check("root_acceleration", ok, ratio, caps.root_acceleration_ratio, "× human").because(
-                format!(
+            let detail = format!(
                 "mean root acceleration {:.2} m/s² against the scaled human's {:.2} (over {:.3} s)",
                 a.motion.mean_mps2, human.mean_mps2, a.window_s
-            ),
-            )
+            );
+            check("root_acceleration", ok, ratio, caps.root_acceleration_ratio, "× human")
+                .because(detail)
         }
         None => {
             let share = a.motion.share_over;
@@ -420,13 +420,15 @@ fn gmr_checks(
     } else {
         (jumps, g.jump_share, "share")
     };
-    let jump = check("gmr_joint_jumps", jumps < g.jump_share && largest < g.severe_jump, value, cap, unit).because(format!(
+    let detail = format!(
         "{:.1} % of transitions with a joint moving more than {} rad, largest {largest:.3} rad (GMR: ≥ {:.0} % or ≥ {} rad once)",
         jumps * 100.0,
         g.jump,
         g.jump_share * 100.0,
         g.severe_jump
-    ));
+    );
+    let ok = jumps < g.jump_share && largest < g.severe_jump;
+    let jump = check("gmr_joint_jumps", ok, value, cap, unit).because(detail);
     let deep = |d: &f64| *d >= g.collision_depth;
     let share = ratio(series.self_depth.iter().filter(|d| deep(d)).count(), frames);
     let run = longest_run(series.self_depth.iter().map(deep)) as f64 / fps;
