@@ -1120,6 +1120,7 @@ impl NpzTarget {
             contacts: Some(retarget::FootContacts {
                 left: (0..frames).map(|f| f % 2 == 0).collect(),
                 right: vec![true; frames],
+                on_toes: None,
             }),
         };
         let dir = std::env::temp_dir().join(format!("retarget-fuzz-npz-{}", std::process::id()));

@@ -21,6 +21,11 @@ pub struct TrackedTargets {
 pub struct FootContacts {
     pub left: Vec<bool>,
     pub right: Vec<bool>,
+    /// Per foot (`[left, right]`) and frame, whether the foot stands on its toes alone: in
+    /// contact with its toe point holding and its heel point not (kneeling, tiptoe, a turn
+    /// on the ball of the foot, push-off). `None` where unknown (contacts read from a file,
+    /// a foot seen through its heel alone).
+    pub on_toes: Option<[Vec<bool>; 2]>,
 }
 
 /// Joint trajectories for one robot: `qpos` per frame in MuJoCo's layout.

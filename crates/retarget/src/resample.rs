@@ -55,10 +55,11 @@ pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMo
             })
             .collect()
     };
-    let contacts = motion
-        .contacts
-        .as_ref()
-        .map(|c| FootContacts { left: nearest(&c.left), right: nearest(&c.right) });
+    let contacts = motion.contacts.as_ref().map(|c| FootContacts {
+        left: nearest(&c.left),
+        right: nearest(&c.right),
+        on_toes: c.on_toes.as_ref().map(|[l, r]| [nearest(l), nearest(r)]),
+    });
     Ok(RobotMotion { fps, qpos, targets, contacts, ..motion.clone() })
 }
 

@@ -447,7 +447,11 @@ fn ground_penetration_covers_every_collision_geom() {
 }
 
 fn contacts(left: impl Fn(usize) -> bool, right: impl Fn(usize) -> bool) -> FootContacts {
-    FootContacts { left: (0..FRAMES).map(left).collect(), right: (0..FRAMES).map(right).collect() }
+    FootContacts {
+        left: (0..FRAMES).map(left).collect(),
+        right: (0..FRAMES).map(right).collect(),
+        on_toes: None,
+    }
 }
 
 #[test]
@@ -490,7 +494,8 @@ fn skating_and_stance_follow_the_source_contacts() {
         "{table}"
     );
     // Contacts of the wrong length are an error.
-    motion.contacts = Some(FootContacts { left: vec![true; 3], right: vec![true; 3] });
+    motion.contacts =
+        Some(FootContacts { left: vec![true; 3], right: vec![true; 3], on_toes: None });
     assert!(report(&motion, &model, &ReportOptions::default()).is_err());
 }
 

@@ -240,6 +240,7 @@ mod tests {
         let contacts = retarget::FootContacts {
             left: vec![true, true, false, false, true],
             right: vec![false, true, true, true, false],
+            on_toes: None,
         };
         let plots = contact_plots(&contacts, 5);
         assert_eq!(plots.len(), 2);

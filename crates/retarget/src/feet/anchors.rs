@@ -284,7 +284,8 @@ mod tests {
                 Pose { quat: [q.w, q.i, q.j, q.k], pos }
             })
             .collect();
-        let contacts = FootContacts { left: vec![true; frames], right: vec![false; frames] };
+        let contacts =
+            FootContacts { left: vec![true; frames], right: vec![false; frames], on_toes: None };
         let options = FootPlanOptions::default();
         plan(&[Some(foot.clone()), None], &contacts, &mut targets, 1, 30.0, &options);
         (targets, foot)

@@ -95,18 +95,26 @@ impl RobotFoot {
     }
 
     /// `rot` pitched toe-down about the foot's own left axis, so that the sole's back end
-    /// rises `lift` (m) above its front.
+    /// rises at least `lift` (m) above its front.
     fn heel_up(&self, rot: &UnitQuaternion<f64>, lift: f64) -> UnitQuaternion<f64> {
         let length = self.length();
-        if lift <= 0.0 || length <= lift {
+        let now = self.heel_lift(rot);
+        if lift <= now.max(0.0) || length <= lift {
             return *rot;
         }
         let forward = rot * self.forward;
         let left = Vector3::z().cross(&forward);
+        let turn = (lift / length).asin() - (now / length).clamp(-1.0, 1.0).asin();
         match nalgebra::Unit::try_new(left, 1e-9) {
-            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (lift / length).asin()) * rot,
+            Some(axis) => UnitQuaternion::from_axis_angle(&axis, turn) * rot,
             None => *rot,
         }
+    }
+
+    /// How far (m) the sole's back end stands above its front at orientation `rot`: its
+    /// length times the sine of its toe-down pitch (negative toes up).
+    fn heel_lift(&self, rot: &UnitQuaternion<f64>) -> f64 {
+        -(rot * self.forward).z * self.length()
     }
 }
 
@@ -127,11 +135,23 @@ pub(super) fn roll_shares(other: &[bool], roll_frames: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Per frame of one foot, how far its planted pose follows the human foot's (0 standing on
+/// its whole sole): `roll`, its tilt, while the other foot stands too ([`roll_shares`]);
+/// `toes`, its heel's lift, where the human foot stands on its toes alone (the same fade;
+/// empty where unknown).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Stand<'a> {
+    pub roll: &'a [f64],
+    pub toes: &'a [f64],
+}
+
 /// Per frame, the planted pose of `foot` (`side` 0 left, 1 right) in its stance `phases`
 /// (`None` out of stance): the flat foot at the phase's anchor (a pivot's turned with the
 /// source's yaw, `free_yaw`, about the ball of the foot, [`RobotFoot::ball_point`]), tilted
 /// as the `free` target within [`FootPlanOptions::sole_band`], rolled by `roll` towards the
-/// free target's tilt, resting at [`FootPlanOptions::clearance`]. A pivot turns on the ball:
+/// free target's tilt, resting at [`FootPlanOptions::clearance`]. Where the human stands on
+/// its toes (`stand.toes`) the foot stands on the front of its sole, its heel as high above
+/// it as the human's (the free target's pitch), rolling no more with the human's foot. A pivot turns on the ball:
 /// as fast as it turns (at `fps` frames a second), it rolls no more with the human's foot,
 /// its heel rises ([`FootPlanOptions::pivot_heel_lift`]) and its outer toe rises
 /// [`CONTACT_PATCH`], so that the ball is the one point it stands on (a rigid sole turning on
@@ -143,7 +163,7 @@ pub(super) fn plant(
     phases: &[Planted],
     free: &[Pose],
     free_yaw: &[f64],
-    roll: &[f64],
+    stand: Stand<'_>,
     fps: f64,
     options: &FootPlanOptions,
 ) -> Vec<Option<Pose>> {
@@ -165,9 +185,12 @@ pub(super) fn plant(
             } else {
                 0.0
             };
-            let q =
-                foot.within_band(&tilt, options.sole_band).slerp(&tilt, roll[t] * (1.0 - turning));
-            let q = foot.heel_up(&q, turning * options.pivot_heel_lift);
+            let toes = stand.toes.get(t).copied().unwrap_or(0.0);
+            let lean = stand.roll[t] * (1.0 - turning) * (1.0 - toes);
+            let q = foot.within_band(&tilt, options.sole_band).slerp(&tilt, lean);
+            let lift =
+                (turning * options.pivot_heel_lift).max(toes * foot.heel_lift(&tilt).max(0.0));
+            let q = foot.heel_up(&q, lift);
             let q = foot.outside_up(&q, turning * CONTACT_PATCH, side);
             let rolled = Pose { quat: [q.w, q.i, q.j, q.k], pos: free[t].pos };
             planted[t] = Some(planted_pose(foot, &rolled, xy, yaw, options.clearance));
@@ -235,6 +258,7 @@ mod tests {
         let contacts = FootContacts {
             left: vec![true; frames],
             right: (0..frames).map(|t| t >= 30).collect(),
+            on_toes: None,
         };
         let feet = [Some(foot.clone()), Some(RobotFoot { slot: 1, ..foot.clone() })];
         plan(&feet, &contacts, &mut targets, 2, fps, &options);
@@ -246,5 +270,51 @@ mod tests {
         assert!(spread(&targets[10 * 2]) <= options.sole_band + 1e-9, "{}", spread(&targets[20]));
         // Deep in the double support: the human's 10°, its corners 3.5 cm apart in height.
         assert!(spread(&targets[45 * 2]) > 0.03, "{}", spread(&targets[90]));
+    }
+
+    /// A foot alone on the floor whose human stands on its toes, 40° toe-down (kneeling,
+    /// tiptoe), in the second half: there the sole's heel stands as high above its toes as
+    /// the human's (sole length × sin 40°) and its front rests on the floor at the anchor;
+    /// in the first half it stands on its whole sole. Without the label, whole sole
+    /// throughout.
+    #[test]
+    fn a_foot_whose_human_stands_on_its_toes_stands_on_the_front_of_its_sole() {
+        let options = FootPlanOptions::default();
+        let mut foot = box_foot();
+        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+        let frames = 60;
+        let toes_down = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 40f64.to_radians());
+        let q = toes_down.quaternion();
+        let tilted = Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.0, 0.0, 0.1) };
+        let beside = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(0.0, 0.3, 0.5) };
+        let feet = [Some(foot.clone()), None];
+        let planned = |on_toes: Option<[Vec<bool>; 2]>| {
+            let mut targets: Vec<Pose> = (0..frames).flat_map(|_| [tilted, beside]).collect();
+            let contacts =
+                FootContacts { left: vec![true; frames], right: vec![false; frames], on_toes };
+            plan(&feet, &contacts, &mut targets, 2, 30.0, &options);
+            targets
+        };
+        let heights = |p: &Pose| -> Vec<f64> {
+            foot.corners.iter().map(|c| (quat(p) * c + p.pos).z).collect()
+        };
+        let lift = |p: &Pose| {
+            let z = heights(p);
+            z.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - z.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let toes: Vec<bool> = (0..frames).map(|t| t >= 30).collect();
+        let on_toes = planned(Some([toes, vec![false; frames]]));
+        let human = 0.2 * 40f64.to_radians().sin();
+        assert!(lift(&on_toes[10 * 2]) <= options.sole_band + 1e-9, "{}", lift(&on_toes[20]));
+        assert!(
+            (lift(&on_toes[50 * 2]) - human).abs() < 1e-6,
+            "{} vs {human}",
+            lift(&on_toes[100])
+        );
+        let lowest = heights(&on_toes[50 * 2]).into_iter().fold(f64::INFINITY, f64::min);
+        assert!((lowest - options.clearance).abs() < 1e-9, "{lowest}");
+        let flat = planned(None);
+        assert!(lift(&flat[50 * 2]) <= options.sole_band + 1e-9, "{}", lift(&flat[100]));
     }
 }

@@ -29,9 +29,10 @@ pub(super) struct Swing {
     pub target: Option<Pose>,
 }
 
-/// Per frame, the [`Swing`] of `foot` (`None` in stance, `planted`, and where it is never
-/// planted): `free` is its free target per frame, `targets` (`frames × slots`) hold its
-/// planted ones.
+/// Per frame, the [`Swing`] of `foot` (`None` in stance, `planted`): `free` is its free
+/// target per frame, `targets` (`frames × slots`) hold its planted ones. A foot never planted
+/// in the clip swings from the clip's first frame to its last (the source may stand on it
+/// in its first and last frames): it clears the floor but in those two frames.
 pub(super) fn swing(
     foot: &RobotFoot,
     planted: &[bool],
@@ -42,13 +43,18 @@ pub(super) fn swing(
     options: &FootPlanOptions,
 ) -> Vec<Option<Swing>> {
     let edges = swing_edges(planted);
+    let never = !planted.contains(&true);
     // (1/30 s at 30 fps is one frame.)
     let lift_frames = (options.lift_s * fps - ROUNDING).ceil();
     (0..planted.len())
         .map(|t| {
-            let (edge, frames_off) = edges[t].filter(|_| !planted[t])?;
+            let (edge, frames_off) = if never {
+                (None, t.min(planted.len() - 1 - t))
+            } else {
+                edges[t].filter(|_| !planted[t]).map(|(edge, off)| (Some(edge), off))?
+            };
             let mut out = Swing::default();
-            if frames_off as f64 <= lift_frames {
+            if let Some(edge) = edge.filter(|_| frames_off as f64 <= lift_frames) {
                 let edge_pose = targets[edge * slots + foot.slot];
                 out.held = held_points(foot, &edge_pose);
             }
@@ -141,9 +147,37 @@ mod tests {
                 Pose { quat: [1.0, 0.0, 0.0, 0.0], pos }
             })
             .collect();
-        let contacts = FootContacts { left: labels.clone(), right: vec![false; frames] };
+        let contacts =
+            FootContacts { left: labels.clone(), right: vec![false; frames], on_toes: None };
         let plan = plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, options);
         (targets, labels, plan)
+    }
+
+    /// A foot the source never stands on in the clip (a 24-frame run cycle's, its toe
+    /// brushing the floor at 4 m/s) swings from the clip's first frame to its last: it clears
+    /// the floor but in those two frames, where it may be landing or leaving.
+    #[test]
+    fn a_foot_never_planted_clears_the_floor_between_the_clip_ends() {
+        let options = FootPlanOptions::default();
+        let mut foot = box_foot();
+        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
+        let (fps, frames) = (30.0, 24);
+        let mut targets: Vec<Pose> = (0..frames)
+            .map(|t| Pose {
+                quat: [1.0, 0.0, 0.0, 0.0],
+                pos: Vector3::new(4.0 * t as f64 / fps, 0.0, 0.02),
+            })
+            .collect();
+        let contacts =
+            FootContacts { left: vec![false; frames], right: vec![false; frames], on_toes: None };
+        let plan = plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, &options);
+        for (t, target) in targets.iter().enumerate().take(frames - 1).skip(1) {
+            assert_eq!(plan.swing_floor[t][0], Some(options.swing_clearance), "frame {t}");
+            assert!(target.pos.z - 0.02 >= options.swing_clearance - 1e-9, "frame {t}");
+            assert!(plan.contact[t][0].is_empty(), "nothing to hold: {t}");
+        }
+        assert!(plan.swing_floor[0][0].unwrap_or(0.0) < options.swing_clearance);
+        assert!(plan.swing_floor[frames - 1][0].unwrap_or(0.0) < options.swing_clearance);
     }
 
     #[test]

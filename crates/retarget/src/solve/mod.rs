@@ -3,6 +3,7 @@
 //!
 //! | # | stage | file | what it does | options |
 //! |---|---|---|---|---|
+//! | 0 | floor | `treadmill.rs` | a source whose feet slide back on its floor as on a treadmill (an in-place loop) put on a floor that stays put | [`crate::contact_phases::ContactOptions`] |
 //! | 1 | targets | `prepare.rs` | the config's IK targets of every frame (GMR's scaling and offsets), the tasks | [`RetargetOptions`] |
 //! | 2 | contacts | `contacts.rs` | the source's foot contact phases (both modes write them) | [`crate::contact_phases::ContactOptions`] |
 //! | 3 | foot plan | `footholds.rs` | the robot's feet planted on them: anchors, soles standing flat, swing floors | [`crate::feet::FootPlanOptions`] |
@@ -14,7 +15,7 @@
 //! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
 //! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
 //! 2 and 5 with GMR's solver and nothing else. A stage with something to say about the clip
-//! pushes a [`StageReport`] (named after its file: `reweigh`, `uncross`) onto
+//! pushes a [`StageReport`] (named after its file: `treadmill`, `reweigh`, `uncross`) onto
 //! [`ClipDiagnostics::stages`].
 
 pub(crate) mod banded;
@@ -27,6 +28,7 @@ mod prepare;
 mod reweigh;
 mod schedule;
 pub mod trajectory;
+mod treadmill;
 mod uncross;
 mod windows;
 
@@ -89,8 +91,12 @@ pub fn retarget_motion(
     config: &IkConfig,
     options: &RetargetOptions,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    // 0. The floor: a source on a treadmill walked off it.
+    let walked = treadmill::walk_off(human, options);
+    let human = walked.as_ref().map_or(human, |(walked, _)| walked);
     // 1. The targets.
     let mut prepared = Prepared::new(human, model, config, options)?;
+    prepared.reports.extend(walked.as_ref().map(|(_, report)| report.clone()));
     // 2. The source's contacts.
     prepared.detect_contacts(human);
     // 3. The foot plan.

@@ -238,7 +238,11 @@ pub(super) fn read_contacts(
         ArrayData::Bool(v) if a.shape == [frames] => Ok(v.clone()),
         _ => Err(format!("`{key}` is not a bool array of {frames} frames")),
     };
-    Ok(FootContacts { left: side(left, "contact_left")?, right: side(right, "contact_right")? })
+    Ok(FootContacts {
+        left: side(left, "contact_left")?,
+        right: side(right, "contact_right")?,
+        on_toes: None,
+    })
 }
 
 pub(super) fn floats(a: &Array) -> Option<&[f64]> {
