@@ -33,11 +33,14 @@ pub struct AccelStats {
 /// Acceleration of the root body (the floating base) and of its IK target.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RootAcceleration {
-    /// The root body (MuJoCo body 1).
+    /// The body measured: the one the root target is for ([`RootAcceleration::target_body`],
+    /// the scaled human's pelvis) when the model has it, else the root body (MuJoCo body 1).
+    /// (Berkeley Humanoid Lite's pelvis target is for `imu_2`, 0.68 m above its base's
+    /// origin, which stands at the floor and swings as the trunk tilts.)
     pub body: String,
     /// 2 g (m/s²).
     pub threshold_mps2: f64,
-    /// The robot's root, from its world position (the free joint's `qpos` translation).
+    /// The robot's [`RootAcceleration::body`], from its world position.
     pub motion: AccelStats,
     /// The scaled human's pelvis: the target position of [`RootAcceleration::target_body`],
     /// when the motion has targets.
@@ -90,8 +93,6 @@ pub(super) fn root_acceleration(
     h: usize,
 ) -> RootAcceleration {
     let frames = motion.num_frames();
-    let robot: Vec<Vector3<f64>> = (0..frames).map(|t| poses.pos(t, 0)).collect();
-    let body = model.bodies.get(1).map(|b| b.name.clone()).unwrap_or_default();
     let target = motion.targets.as_ref().and_then(|targets| {
         let k = targets.body_names.len();
         let j = match root_target {
@@ -103,6 +104,11 @@ pub(super) fn root_acceleration(
         Some((p, targets.body_names[j].clone()))
     });
     let (target, target_body) = target.unzip();
+    // The body the target is for, else the root (body 1; `poses` leaves out the world).
+    let id = target_body.as_deref().and_then(|name| model.body_id(name)).filter(|&b| b > 0);
+    let id = id.unwrap_or(1);
+    let robot: Vec<Vector3<f64>> = (0..frames).map(|t| poses.pos(t, id - 1)).collect();
+    let body = model.bodies.get(id).map(|b| b.name.clone()).unwrap_or_default();
     let fps = motion.fps;
     RootAcceleration {
         body,
