@@ -362,6 +362,32 @@ fn every_shared_fbx_onto_the_g1_and_the_t1_in_both_solves() {
     }
 }
 
+/// Issue 40, item 5: what HumanML3D's "joints to BVH" converters write (SMPL's 22 joints on
+/// SMPL's template in its T zero pose, metres, the root OFFSET below the body model's origin),
+/// with SMPL's names and with HumanIK's, onto the G1 and the T1 in both solves. With `--gmr`
+/// the HumanIK-named one took GMR's tuned LAFAN1 config and stood the G1 on its head (upright
+/// in 0 % of the frames).
+#[test]
+fn humanml3d_exports_onto_the_g1_and_the_t1_in_both_solves() {
+    for key in ["unitree_g1", "booster_t1_29dof"] {
+        let model = shipped_model(key);
+        let tuned = tuned(key);
+        for file in ["humanml3d_smpl_walk.bvh", "hik_metres_walk.bvh"] {
+            let path = root().join("crates/fk/tests/data/skeletons").join(file);
+            let bvh = bvh::from_path(&path).unwrap();
+            for mode in [SolveMode::default(), SolveMode::Gmr] {
+                let gmr = mode == SolveMode::Gmr;
+                let mut options = RetargetOptions::default();
+                options.mode = mode;
+                let checks = run_with(&model, key, &bvh, tuned.as_ref(), &options);
+                let what = format!("{file} → {key} ({})", if gmr { "--gmr" } else { "default" });
+                assert_sane(&what, &checks, true);
+                assert_eq!(checks.choice, Choice::Derived, "{what}");
+            }
+        }
+    }
+}
+
 /// The whole Rigify take (the test above sees its first 450 frames only): a subject standing
 /// with nearly straight knees. Their slight sideways bend was read as the knees' flexion axis,
 /// and the derived config turned the thighs and shins 95° and 187° about their bones: targets
