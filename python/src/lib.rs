@@ -101,8 +101,9 @@ fn build(
 ///     robot: a shipped robot (``"unitree_g1"``, see ``retarget.shipped_robots()``) or the
 ///         path of an MJCF (``.xml``) or URDF (``.urdf``) file.
 ///     config: an IK config file (GMR's JSON schema). Default: for a BVH, GMR's tuned config
-///         for LAFAN1-named skeletons on shipped robots, else one derived from the skeleton's
-///         and the robot's roles; for frames, the shipped robot's tuned config.
+///         for LAFAN1 skeletons (names and joint frames, in either mode) on shipped robots,
+///         else one derived from the skeleton's and the robot's roles; for frames, the
+///         shipped robot's tuned config.
 ///     mode: ``"default"`` (planted feet, ground, self-collision and joint-speed
 ///         constraints, a smoothing pass), ``"gmr"`` (GMR's exact solve), ``"causal"``
 ///         (the default's constraints without planting or smoothing: what ``step`` runs) or

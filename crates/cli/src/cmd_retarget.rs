@@ -47,7 +47,8 @@ pub struct MainArgs {
     pub output: Option<PathBuf>,
     /// IK config (GMR schema), used as given; a role-named config (`retarget robot init`) is
     /// bound to the skeleton. Default: GMR's tuned config for a shipped robot and a
-    /// LAFAN1-named skeleton, else a config derived from the robot's and the skeleton's roles.
+    /// LAFAN1 skeleton (its names and joint frames), else a config derived from the robot's and
+    /// the skeleton's roles.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Subject height in metres (default: estimated from the skeleton; GMR assumes 1.75).

@@ -34,7 +34,12 @@ use crate::{AxisConvention, Error};
 ///    to either `o` or zero → [`PositionReading::World`].
 /// 3. Otherwise the one axis that tells the two local readings apart best decides: the
 ///    channel whose median absolute deviation over those frames is smallest for the size of
-///    its OFFSET component (for a root: the height, not the floor plan it walks). Its median
+///    its OFFSET component (for a root: the height, not the floor plan it walks). When the
+///    zero pose stands along that axis (its lowest point below the joint by at least half
+///    the joint's reach), the reading that stands the joint that far above 0, the floor,
+///    is chosen: HumanML3D's converters write SMPL's pelvis in the body model (0.22 m *below*
+///    its origin) as the root OFFSET and the world position in the channels, a Rigify
+///    export its standing height as the OFFSET and sway in the channels. Otherwise its median
 ///    nearer that component than zero → [`PositionReading::Local`], else
 ///    [`PositionReading::Added`].
 ///
@@ -232,6 +237,7 @@ impl Plan {
             })
             .collect();
         let n = self.joints.len();
+        let stands = self.zero_pose_stands();
         // Global pose of joint i in sample s at [s * n + i].
         let mut poses = vec![(math::IDENTITY, [0.0; 3]); rows.len() * n];
         for i in 0..n {
@@ -239,7 +245,8 @@ impl Plan {
                 let parents: Option<Vec<(Quat, [f64; 3])>> = self.joints[i]
                     .parent
                     .map(|j| (0..rows.len()).map(|s| poses[s * n + j]).collect());
-                let (reading, reason) = self.joints[i].read(&rows, parents.as_deref(), scale);
+                let (reading, reason) =
+                    self.joints[i].read(&rows, parents.as_deref(), scale, stands[i]);
                 self.joints[i].reading = reading;
                 let joint = bvh.skeleton.joints[i].name.clone();
                 self.position_channels.push(PositionChannels { joint, reading, reason });
@@ -249,6 +256,37 @@ impl Plan {
                 poses[s * n + i] = joint.pose(row, joint.parent.map(|j| poses[s * n + j]));
             }
         }
+    }
+}
+
+impl Plan {
+    /// Per joint and axis, how far the zero pose's lowest point under the joint lies below
+    /// it when the zero pose stands along that axis (at least half the joint's reach, its
+    /// farthest descendant in any direction, lies below it), else `None`.
+    fn zero_pose_stands(&self) -> Vec<[Option<f64>; 3]> {
+        let n = self.joints.len();
+        let mut at = vec![[0.0; 3]; n];
+        for i in 0..n {
+            let base = self.joints[i].parent.map_or([0.0; 3], |p| at[p]);
+            at[i] = std::array::from_fn(|k| base[k] + self.joints[i].offset[k]);
+        }
+        (0..n)
+            .map(|i| {
+                if !self.joints[i].has_positions() {
+                    return [None; 3];
+                }
+                let mut under = vec![false; n];
+                let (mut below, mut reach) = ([0.0_f64; 3], 0.0_f64);
+                for j in i + 1..n {
+                    under[j] = self.joints[j].parent.is_some_and(|p| p == i || under[p]);
+                    if under[j] {
+                        reach = reach.max(distance(at[j], at[i]));
+                        below = std::array::from_fn(|k| below[k].max(at[i][k] - at[j][k]));
+                    }
+                }
+                below.map(|d| (d > 0.0 && 2.0 * d >= reach).then_some(d))
+            })
+            .collect()
     }
 }
 
@@ -285,12 +323,14 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 impl JointPlan {
     /// This joint's reading from the sampled `rows` (frame 0 first) and, for a non-root
-    /// joint, its parent's global pose in each of them (see [`PositionReading`]).
+    /// joint, its parent's global pose in each of them; `stands`: how far below it the zero
+    /// pose reaches along each axis it stands on (see [`PositionReading`]).
     fn read(
         &self,
         rows: &[Row],
         parents: Option<&[(Quat, [f64; 3])]>,
         scale: f64,
+        stands: [Option<f64>; 3],
     ) -> (PositionReading, String) {
         if self.repeats_offset(&rows[0].values, scale) {
             return (PositionReading::Local, "frame 0 repeats the OFFSET".to_owned());
@@ -307,7 +347,7 @@ impl JointPlan {
                 return (PositionReading::World, why);
             }
         }
-        self.local_or_added(rows, o, REPEAT_TOLERANCE * norm(self.offset).max(scale))
+        self.local_or_added(rows, o, REPEAT_TOLERANCE * norm(self.offset).max(scale), stands)
     }
 
     /// The OFFSET on the axes with a position channel (0 elsewhere, like [`Self::channels`]).
@@ -335,13 +375,16 @@ impl JointPlan {
 
     /// Local or Added, decided on the one axis that tells them apart best: the channel whose
     /// spread over the clip (median absolute deviation) is smallest for the size of its
-    /// OFFSET component (a root's height, not the floor plan it walks). Its median value
-    /// nearer that component than zero is `Local`.
+    /// OFFSET component (a root's height, not the floor plan it walks). Where the zero pose
+    /// stands along that axis (`stands`), the reading that puts the joint its zero pose's
+    /// depth above 0 is chosen; else its median value nearer that component than zero is
+    /// `Local`.
     fn local_or_added(
         &self,
         rows: &[Row],
         o: [f64; 3],
         tolerance: f64,
+        stands: [Option<f64>; 3],
     ) -> (PositionReading, String) {
         let mut best: Option<(f64, usize, f64)> = None; // (score, axis, median)
         for (k, column) in self.position_columns.iter().enumerate() {
@@ -363,6 +406,22 @@ impl JointPlan {
         };
         let axis = ["X", "Y", "Z"][k];
         let (o, m) = (o[k], m);
+        if let Some(depth) = stands[k] {
+            return if (m - depth).abs() <= (m + o - depth).abs() {
+                let why = format!(
+                    "{axis} median {m:.4} stands it {m:.4} above 0, nearer its zero pose's depth \
+                     {depth:.4} than with the OFFSET's {o:.4} added"
+                );
+                (PositionReading::Local, why)
+            } else {
+                let why = format!(
+                    "{axis} median {m:.4} plus the OFFSET's {o:.4} stands it {:.4} above 0, nearer \
+                     its zero pose's depth {depth:.4} than the median alone",
+                    m + o
+                );
+                (PositionReading::Added, why)
+            };
+        }
         if (m - o).abs() <= m.abs() {
             let why = format!("{axis} median {m:.4} is nearer the OFFSET's {o:.4} than 0");
             (PositionReading::Local, why)

@@ -101,7 +101,11 @@ fn a_root_offset_at_standing_height_included_in_the_channels_is_not_added() {
     let (read, why) = reading(&report, "Hips");
     assert_eq!(read, PositionReading::Local, "{why}");
     // Y is the axis that varies least for its OFFSET component: the height decides.
-    assert_eq!(why, "Y median 97.0672 is nearer the OFFSET's 100.0000 than 0");
+    assert_eq!(
+        why,
+        "Y median 97.0672 stands it 97.0672 above 0, nearer its zero pose's depth 100.0000 than \
+         with the OFFSET's 100.0000 added"
+    );
     assert_near(at(&motion, 0, "Hips"), [300.0, 97.0, -250.0]);
     let sole = at(&motion, 10, "Foot_End");
     assert!((sole.y - (97.0 + 7f64.sin() - 100.0)).abs() < 1e-9, "{sole:?}");
@@ -119,10 +123,33 @@ fn a_root_offset_missing_from_the_channels_is_added() {
     let (motion, report) = file_frame_fk(&bvh);
     assert_eq!(
         reading(&report, "Hips"),
-        (PositionReading::Added, "Y median -0.5000 is nearer 0 than the OFFSET's 100.0000".into())
+        (
+            PositionReading::Added,
+            "Y median -0.5000 plus the OFFSET's 100.0000 stands it 99.5000 above 0, nearer its \
+             zero pose's depth 100.0000 than the median alone"
+                .into()
+        )
     );
     assert_near(at(&motion, 0, "Hips"), [0.6, 99.0, 0.3]);
     assert_near(at(&motion, 1, "Foot_End"), [0.7, -0.5, 0.2]);
+}
+
+#[test]
+fn a_root_offset_below_the_origin_with_the_world_position_in_the_channels_is_not_added() {
+    // HumanML3D's converters (smpl2bvh, joints2bvh): the root OFFSET is where SMPL's body
+    // model has its pelvis, 22 below its origin, the channels the pelvis's world position.
+    // The channels' median (93) is nearer 0 than that OFFSET, but added to it the feet would
+    // sink 22 under the floor the walk is on.
+    let bvh = parse(
+        &hips_and_leg("0 -22 3"),
+        "0.05",
+        &["0 100.5 3 0 0 0 0 0 0 0 0 0", "0 99 13 0 0 0 0 0 0 0 0 0"],
+    );
+    let (motion, report) = file_frame_fk(&bvh);
+    let (read, why) = reading(&report, "Hips");
+    assert_eq!(read, PositionReading::Local, "{why}");
+    assert_near(at(&motion, 0, "Hips"), [0.0, 100.5, 3.0]);
+    assert_near(at(&motion, 1, "Foot_End"), [0.0, -1.0, 13.0]);
 }
 
 #[test]

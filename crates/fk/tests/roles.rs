@@ -302,6 +302,78 @@ fn smpl_in_metres_l_foot_is_the_toe() {
     );
 }
 
+/// HumanML3D's "joints to BVH" converters (momask's and T2M-GPT's `joints2bvh`, `smpl2bvh`):
+/// SMPL's 22 joints on SMPL's template body in its T zero pose (every frame turns the arms
+/// down), metres, Y up, End Sites at their joints, the root OFFSET where SMPL's body model
+/// has its pelvis (22 cm below its origin) and the pelvis's world position in the channels;
+/// named as SMPL (`L_Hip`, or HumanML3D's `left_hip`) or with HumanIK's names.
+#[test]
+fn humanml3d_exports_on_smpls_template_in_smpl_or_humanik_names() {
+    let smpl_names = (
+        ["Pelvis", "Spine1", "Spine3", "Neck", "Head"],
+        [
+            ["L_Collar", "L_Shoulder", "L_Elbow", "L_Wrist"],
+            ["R_Collar", "R_Shoulder", "R_Elbow", "R_Wrist"],
+        ],
+        [["L_Hip", "L_Knee", "L_Ankle", "L_Foot"], ["R_Hip", "R_Knee", "R_Ankle", "R_Foot"]],
+    );
+    // HumanML3D's own joint list: `pelvis`, `left_hip`, `spine1`, `left_foot` (the toe).
+    let humanml3d = |name: &str| {
+        let name = name.replacen("L_", "left_", 1).replacen("R_", "right_", 1);
+        name.to_lowercase()
+    };
+    let text = std::fs::read_to_string(skeleton("humanml3d_smpl_walk.bvh")).unwrap();
+    let lower: String = text
+        .lines()
+        .map(|line| match line.trim_start().split_once(' ') {
+            Some(("ROOT" | "JOINT", name)) => line.replace(name, &humanml3d(name)),
+            _ => line.to_owned(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let lower_names = (
+        smpl_names.0.map(humanml3d),
+        smpl_names.1.map(|side| side.map(humanml3d)),
+        smpl_names.2.map(|side| side.map(humanml3d)),
+    );
+    let hik = lafan_style("", "Spine2", "ToeBase");
+    let files = [
+        ("humanml3d_smpl_walk.bvh", bvh::parse(text.as_bytes()).unwrap(), owned(&smpl_names)),
+        ("humanml3d (left_hip)", bvh::parse(lower.as_bytes()).unwrap(), lower_names),
+        ("hik_metres_walk.bvh", bvh::from_path(&skeleton("hik_metres_walk.bvh")).unwrap(), hik),
+    ];
+    for (file, bvh, names) in files {
+        let (motion, report) = fk::human_motion(&bvh, &FkOptions::default()).unwrap();
+        let h = humanoid(&report, file);
+        expect_owned(&h, file, &names);
+        assert_eq!(h.up, UpAxis::PosY, "{file}: {}", h.up_reason);
+        assert_eq!(report.metres_per_unit, 1.0, "{file}: {}", report.unit_reason);
+        assert_eq!(h.rest_pose, RestPose::TPose, "{file}: {}", h.rest_reason);
+        // The channels are the pelvis's place: the walk is on the floor at 0 (read as added
+        // to the OFFSET, it sank 22 cm under it), the pelvis 0.94 m above it.
+        let root = &report.position_channels[0];
+        assert_eq!(root.reading, fk::PositionReading::Local, "{file}: {}", root.reason);
+        assert!(report.ground.abs() < 0.02, "{file}: ground {}", report.ground);
+        let pelvis = motion.body_names.iter().position(|b| b == &names.0[0]).unwrap();
+        let z = motion.positions[pelvis].z;
+        assert!((z - 0.96).abs() < 0.02, "{file}: pelvis at {z} m in frame 0");
+        // The head joint ends the trunk (a zero End Site): a skull is added above it.
+        assert!((1.6..1.8).contains(&report.height), "{file}: {report:?}");
+    }
+}
+
+/// A borrowed name table as an owned one ([`expect_owned`]).
+fn owned(
+    names: &([&str; 5], [[&str; 4]; 2], [[&str; 4]; 2]),
+) -> ([String; 5], [[String; 4]; 2], [[String; 4]; 2]) {
+    let side = |s: &[&str; 4]| s.map(str::to_owned);
+    (
+        names.0.map(str::to_owned),
+        [side(&names.1[0]), side(&names.1[1])],
+        [side(&names.2[0]), side(&names.2[1])],
+    )
+}
+
 #[test]
 fn asf_style_in_millimetres() {
     let (_, h) = own("asf_millimetres.bvh", UpAxis::PosY, 0.001, RestPose::ArmsDown);

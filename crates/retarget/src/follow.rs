@@ -13,6 +13,11 @@
 //!
 //! blocked frames at most 0.2 s apart form a stretch, and stretches of at least 1 s are
 //! reported (shorter ones are kicks and turns the solve catches up with), with the joints at a bound in at least half of their frames.
+//!
+//! An arm hangs from the chest: when the chest body itself is more than 45° off its own
+//! target on average over the stretch, that is said instead of blaming the arm's ranges (the
+//! MocapBank take under `--gmr` onto the G1: GMR's first frame, from `qpos0` turned 96° from
+//! the subject, left the waist yawed, the torso 85° off, the left arm's joints at their limits).
 
 // Indexing: body and joint ids come from the model the motion was solved on (the motion's
 // names are checked against it first), frames below `num_frames`.
@@ -38,6 +43,9 @@ const GAP: f64 = 0.2;
 const MIN_STRETCH: f64 = 1.0;
 /// A joint is named when it is at a bound in at least this share of the stretch's frames.
 const NAMED_SHARE: f64 = 0.5;
+/// An arm's chest this far off its own orientation target (rad, mean over the stretch) holds
+/// the arm away from the human's pose whatever the arm's ranges.
+const TRUNK_OFF: f64 = 45.0 * std::f64::consts::PI / 180.0;
 
 /// One joint held at a bound through a stretch.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +71,9 @@ pub struct Blocked {
     pub joints: Vec<PinnedJoint>,
     /// Mean over the stretch of the limb's largest distance to a target (m).
     pub error: f64,
+    /// The body an arm hangs from (the chest) and its mean rotation error over the stretch
+    /// (rad), when that is more than 45°: the trunk, not the arm's ranges, is off.
+    pub trunk_off: Option<(String, f64)>,
 }
 
 impl fmt::Display for Blocked {
@@ -80,10 +91,18 @@ impl fmt::Display for Blocked {
                 )
             })
             .collect();
+        let why = match &self.trunk_off {
+            Some((body, angle)) => format!(
+                "{body}, which it hangs from, is {:.0}° off its own target: the trunk keeps the \
+                 limb from the human's pose",
+                angle.to_degrees()
+            ),
+            None => "the joint ranges keep the limb from the human's pose".to_owned(),
+        };
         write!(
             f,
             "the {} cannot follow the human in frames {}-{} ({:.1} s): {}; its targets stay \
-             {:.0} cm away on average (the joint ranges keep the limb from the human's pose)",
+             {:.0} cm away on average ({why})",
             self.limb,
             self.first,
             self.last,
@@ -94,15 +113,17 @@ impl fmt::Display for Blocked {
     }
 }
 
-/// One frame of a limb: its joints at a bound (joint id, whether the lower one) and its
-/// largest distance to a target.
-type FrameState = (Vec<(usize, bool)>, f64);
+/// One frame of a limb: its joints at a bound (joint id, whether the lower one), its largest
+/// distance to a target, and the rotation error of the chest an arm hangs from (rad).
+type FrameState = (Vec<(usize, bool)>, f64, Option<f64>);
 
-/// A limb: its name, the bodies of its chain, the bodies whose targets say where it is.
+/// A limb: its name, the bodies of its chain, the bodies whose targets say where it is, and
+/// for an arm the chest body it hangs from.
 struct LimbSpec {
     name: String,
     joints: Vec<usize>,
     tracked: Vec<usize>,
+    trunk: Option<usize>,
 }
 
 fn limbs(model: &Model, roles: &RobotRoles) -> Vec<LimbSpec> {
@@ -122,6 +143,8 @@ fn limbs(model: &Model, roles: &RobotRoles) -> Vec<LimbSpec> {
             ("leg", Role::Pelvis, [Part::Thigh, Part::Shin, Part::Foot]),
             ("arm", Role::Chest, [Part::UpperArm, Part::Forearm, Part::Hand]),
         ] {
+            let chest = roles.body(top).filter(|_| top == Role::Chest);
+            let chest = chest.filter(|&c| Some(c) != roles.body(Role::Pelvis));
             let top = roles.body(top).or_else(|| roles.body(Role::Pelvis)).unwrap_or(0);
             let ends: Vec<usize> =
                 parts.iter().filter_map(|&p| roles.body(Role::of(p, side))).collect();
@@ -141,6 +164,7 @@ fn limbs(model: &Model, roles: &RobotRoles) -> Vec<LimbSpec> {
                 name: format!("{word} {limb}"),
                 joints,
                 tracked: ends[1..].to_vec(),
+                trunk: chest,
             });
         }
     }
@@ -192,7 +216,11 @@ pub fn blocked_limbs(model: &Model, roles: &RobotRoles, motion: &RobotMotion) ->
                     Some((data.xpos[b] - target).norm())
                 })
                 .fold(0.0, f64::max);
-            out.push((pinned, error));
+            let trunk = spec.trunk.and_then(|b| {
+                let target = targets.quat.get(t * targets.body_names.len() + k_of(b)?)?;
+                Some(data.xquat[b].angle_to(target))
+            });
+            out.push((pinned, error, trunk));
         }
     }
     let mut blocked = Vec::new();
@@ -200,15 +228,17 @@ pub fn blocked_limbs(model: &Model, roles: &RobotRoles, motion: &RobotMotion) ->
         // The limb's usual distance to its targets (scaled human targets are rarely met
         // exactly): the median over the frames with no joint at a bound.
         let mut free: Vec<f64> =
-            series.iter().filter(|(p, _)| p.is_empty()).map(|(_, e)| *e).collect();
+            series.iter().filter(|(p, _, _)| p.is_empty()).map(|(_, e, _)| *e).collect();
         if free.is_empty() {
-            free = series.iter().map(|(_, e)| *e).collect();
+            free = series.iter().map(|(_, e, _)| *e).collect();
         }
         free.sort_by(f64::total_cmp);
         let usual = free.get(free.len() / 2).copied().unwrap_or(0.0);
         let is_blocked: Vec<bool> = series
             .iter()
-            .map(|(pinned, error)| !pinned.is_empty() && *error > usual + OFF_TARGET * roles.height)
+            .map(|(pinned, error, _)| {
+                !pinned.is_empty() && *error > usual + OFF_TARGET * roles.height
+            })
             .collect();
         for (first, last) in stretches(&is_blocked, motion.fps) {
             blocked.push(describe(model, spec, &series[first..=last], first, last, motion.fps));
@@ -245,7 +275,7 @@ fn describe(
     let mut joints: Vec<PinnedJoint> = Vec::new();
     for &j in &spec.joints {
         for lower in [true, false] {
-            let count = series.iter().filter(|(p, _)| p.contains(&(j, lower))).count();
+            let count = series.iter().filter(|(p, _, _)| p.contains(&(j, lower))).count();
             let share = count as f64 / n;
             if share >= NAMED_SHARE {
                 let joint = &model.joints[j];
@@ -265,11 +295,12 @@ fn describe(
             .joints
             .iter()
             .flat_map(|&j| [(j, true), (j, false)])
-            .max_by_key(|key| series.iter().filter(|(p, _)| p.contains(key)).count());
+            .max_by_key(|key| series.iter().filter(|(p, _, _)| p.contains(key)).count());
         if let Some((j, lower)) = best {
             let joint = &model.joints[j];
             let [lo, hi] = joint.range.unwrap_or([0.0, 0.0]);
-            let share = series.iter().filter(|(p, _)| p.contains(&(j, lower))).count() as f64 / n;
+            let share =
+                series.iter().filter(|(p, _, _)| p.contains(&(j, lower))).count() as f64 / n;
             joints.push(PinnedJoint {
                 name: joint.name.clone(),
                 bound: if lower { lo } else { hi },
@@ -278,8 +309,14 @@ fn describe(
             });
         }
     }
-    let error = series.iter().map(|(_, e)| e).sum::<f64>() / n;
-    Blocked { limb: spec.name.clone(), first, last, fps, joints, error }
+    let error = series.iter().map(|(_, e, _)| e).sum::<f64>() / n;
+    let trunk: Vec<f64> = series.iter().filter_map(|(_, _, a)| *a).collect();
+    let trunk_mean = trunk.iter().sum::<f64>() / trunk.len().max(1) as f64;
+    let trunk_off = spec
+        .trunk
+        .filter(|_| trunk_mean > TRUNK_OFF)
+        .map(|b| (model.bodies[b].name.clone(), trunk_mean));
+    Blocked { limb: spec.name.clone(), first, last, fps, joints, error, trunk_off }
 }
 
 #[cfg(test)]

@@ -362,6 +362,32 @@ fn every_shared_fbx_onto_the_g1_and_the_t1_in_both_solves() {
     }
 }
 
+/// Issue 40, item 5: what HumanML3D's "joints to BVH" converters write (SMPL's 22 joints on
+/// SMPL's template in its T zero pose, metres, the root OFFSET below the body model's origin),
+/// with SMPL's names and with HumanIK's, onto the G1 and the T1 in both solves. With `--gmr`
+/// the HumanIK-named one took GMR's tuned LAFAN1 config and stood the G1 on its head (upright
+/// in 0 % of the frames).
+#[test]
+fn humanml3d_exports_onto_the_g1_and_the_t1_in_both_solves() {
+    for key in ["unitree_g1", "booster_t1_29dof"] {
+        let model = shipped_model(key);
+        let tuned = tuned(key);
+        for file in ["humanml3d_smpl_walk.bvh", "hik_metres_walk.bvh"] {
+            let path = root().join("crates/fk/tests/data/skeletons").join(file);
+            let bvh = bvh::from_path(&path).unwrap();
+            for mode in [SolveMode::default(), SolveMode::Gmr] {
+                let gmr = mode == SolveMode::Gmr;
+                let mut options = RetargetOptions::default();
+                options.mode = mode;
+                let checks = run_with(&model, key, &bvh, tuned.as_ref(), &options);
+                let what = format!("{file} → {key} ({})", if gmr { "--gmr" } else { "default" });
+                assert_sane(&what, &checks, true);
+                assert_eq!(checks.choice, Choice::Derived, "{what}");
+            }
+        }
+    }
+}
+
 /// The whole Rigify take (the test above sees its first 450 frames only): a subject standing
 /// with nearly straight knees. Their slight sideways bend was read as the knees' flexion axis,
 /// and the derived config turned the thighs and shins 95° and 187° about their bones: targets
@@ -585,7 +611,8 @@ fn small(name: &str) -> mjcf::Model {
 }
 
 /// The MocapBank take sits on a chair: the G1's left hip pitch stops at −90°, so its left leg
-/// cannot follow the human there, and the tool says so (`retarget::blocked_limbs`); the LAFAN1 walk's
+/// cannot follow the human there, and the tool says so (`retarget::blocked_limbs`); under
+/// `--gmr` the left arm cannot either, and the tool says the trunk is why; the LAFAN1 walk's
 /// start is walked without such a stretch.
 #[test]
 fn a_limb_held_at_its_joint_limits_is_said_not_to_follow() {
@@ -606,6 +633,24 @@ fn a_limb_held_at_its_joint_limits_is_said_not_to_follow() {
     assert!(leg.last - leg.first > 150, "{leg}");
     assert!(leg.joints.iter().any(|j| j.name == "left_hip_pitch_joint" && j.lower), "{leg}");
     assert!(leg.to_string().contains("cannot follow the human"), "{leg}");
+    assert_eq!(leg.trunk_off, None, "{leg}");
+    assert!(leg.to_string().contains("the joint ranges keep the limb"), "{leg}");
+    // With --gmr, GMR's first frame (from qpos0, turned 96° from the subject) leaves the waist
+    // yawed and the torso far off its target: the left arm's stretches say so, rather than
+    // blaming the arm's ranges.
+    let bvh = bvh::from_path(&path).unwrap();
+    let chosen =
+        derive::choose(&model, "unitree_g1", &bvh, &fk::FkOptions::default(), None, None, true)
+            .unwrap();
+    let gmr =
+        retarget::internals::retarget_bvh(&bvh, &model, &chosen.config, &RetargetOptions::gmr())
+            .unwrap()
+            .0;
+    let blocked = retarget::blocked_limbs(&model, &roles, &gmr);
+    let arm = blocked.iter().find(|b| b.limb == "left arm").expect("the left arm is blocked");
+    let (trunk, angle) = arm.trunk_off.clone().unwrap_or_else(|| panic!("{arm}"));
+    assert!(trunk == "torso_link" && angle.to_degrees() > 45.0, "{arm}");
+    assert!(arm.to_string().contains("the trunk keeps the limb"), "{arm}");
     let Some(walk) = lafan_walk() else { return };
     let motion = solve(&walk);
     assert_eq!(retarget::blocked_limbs(&model, &roles, &motion), []);

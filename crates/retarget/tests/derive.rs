@@ -179,7 +179,7 @@ fn a_pelvis_that_is_also_the_chest_gets_the_chest_weights() {
 /// of the robot: on every shipped robot (each has one), every LAFAN1 take (both samples and the
 /// shared LAFAN1 files) gets it, every other shared skeleton gets the derived config, and so do a
 /// LAFAN1 take read with another up axis and a LAFAN1-named skeleton standing upright in its zero
-/// pose (the names fit, the joint frames are not LAFAN1's).
+/// pose (the names fit, the joint frames are not LAFAN1's), with `--gmr` too.
 #[test]
 fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
     let Some(dir) = shared::shared_file("data/bvh") else { return };
@@ -199,6 +199,9 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
         })
         .collect();
     let upright = bvh::parse(upright_lafan1_named_bvh().as_bytes()).unwrap();
+    // A HumanML3D `joints2bvh` export: HumanIK's names on SMPL's T zero pose, in metres.
+    let hik =
+        bvh::from_path(&root().join("crates/fk/tests/data/skeletons/hik_metres_walk.bvh")).unwrap();
     let default = fk::FkOptions::default();
     let z_up = fk::FkOptions { axes: fk::AxisConvention::ZUp, ..fk::FkOptions::default() };
     let mut lafan = 0;
@@ -225,11 +228,19 @@ fn the_tuned_config_is_chosen_for_lafan1_skeletons_only() {
         let chosen = choose(&upright, &default);
         assert_eq!(chosen.choice, Choice::Derived, "upright → {key}: {}", chosen.summary);
         assert!(chosen.summary.contains("from LAFAN1's"), "{}", chosen.summary);
-        // With --gmr the tuned config whenever the skeleton has its names (GMR's behaviour),
-        // whatever its joint frames; GMR's solve with the derived config where it has not
-        // (GMR stops with a KeyError there).
-        let gmr = derive::choose(&model, key, &upright, &default, None, Some(&tuned), true);
-        assert_eq!(gmr.unwrap().choice, Choice::Tuned);
+        // With --gmr too the tuned config only on LAFAN1's joint frames (GMR would take it on
+        // any skeleton with the names, and stand a T zero pose on its head); GMR's solve with
+        // the derived config elsewhere (GMR stops with a KeyError on other names).
+        for (name, bvh) in [("upright", &upright), ("hik_metres_walk", &hik)] {
+            let gmr = derive::choose(&model, key, bvh, &default, None, Some(&tuned), true).unwrap();
+            assert_eq!(gmr.choice, Choice::Derived, "{name} --gmr → {key}: {}", gmr.summary);
+            assert!(gmr.summary.contains("from LAFAN1's"), "{}", gmr.summary);
+            assert!(gmr.summary.contains("--gmr: GMR's solve"), "{}", gmr.summary);
+        }
+        for (name, bvh) in clips.iter().filter(|(name, _)| name.starts_with("lafan1")) {
+            let gmr = derive::choose(&model, key, bvh, &default, None, Some(&tuned), true).unwrap();
+            assert_eq!(gmr.choice, Choice::Tuned, "{name} --gmr → {key}: {}", gmr.summary);
+        }
         let cmu: Vec<_> = clips.iter().filter(|(name, _)| name.starts_with("cmu")).collect();
         assert!(!cmu.is_empty(), "the CMU files of the shared data");
         for (name, bvh) in cmu {

@@ -381,11 +381,11 @@ pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<Hu
 
 /// The config for retargeting `bvh` onto `model` when no config was written for the pair:
 /// - `given` (`--config`): as written, or bound to the skeleton when it is role-named;
-/// - `tuned` (a config written for [`LAFAN1_FRAMES`], as the shipped ones are) with `gmr`
-///   (`--gmr`): the tuned config whenever the skeleton has the human bodies it names (GMR's
-///   exact behaviour), else the derived one (GMR stops with a `KeyError` there);
-/// - `tuned` when the skeleton has its human body names and LAFAN1's joint frames
-///   ([`JointFrames::differs`]: a property of the skeleton, whatever the motion);
+/// - `tuned` (a config written for [`LAFAN1_FRAMES`], as the shipped ones are) when the
+///   skeleton has its human body names and LAFAN1's joint frames ([`JointFrames::differs`]:
+///   a property of the skeleton, whatever the motion), with or without `gmr` (`--gmr`: GMR
+///   takes it on any skeleton with the names, but its rotation offsets hold only for those
+///   frames; GMR stops with a `KeyError` on other names);
 /// - otherwise the config derived from the robot's and the skeleton's roles.
 ///
 /// `robot` names the robot in messages.
@@ -412,32 +412,33 @@ pub fn choose(
     let mut why_not = String::new();
     if let Some(tuned) = tuned {
         let names = fk::body_names(bvh, fk_options)?;
-        let fits = tuned.validate(model, &names);
-        if gmr && fits.is_ok() {
-            let summary = format!("config {} (tuned; --gmr)", tuned.source);
-            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-        }
-        if gmr {
+        let solve = if gmr { "; --gmr: GMR's solve" } else { "" };
+        if tuned.validate(model, &names).is_err() {
             // GMR itself stops here (a KeyError on the first missing body); GMR's solve with
             // the derived config is the nearest thing, and what `--gmr` comparisons need.
-            why_not = format!(
-                " (--gmr: GMR's solve; the tuned {} names bodies the skeleton lacks)",
-                tuned.source
-            );
-        } else if fits.is_ok() {
+            if gmr {
+                why_not = format!(
+                    " (--gmr: GMR's solve; the tuned {} names bodies the skeleton lacks)",
+                    tuned.source
+                );
+            }
+        } else {
+            // GMR would take the tuned config on any skeleton with these names; its rotation
+            // offsets hold only for LAFAN1's joint frames (a HumanIK or joints2bvh export
+            // in a T zero pose stood on its head with them), so `--gmr` asks the same.
             let humanoid = fk::recognise(bvh, &fk_options.roles)?;
             let frames = LAFAN1_FRAMES;
             match frames.differs(&humanoid, fk_options.axes) {
                 None => {
                     let summary = format!(
-                        "config {} (tuned: the skeleton has its names and {}'s joint frames)",
+                        "config {} (tuned: the skeleton has its names and {}'s joint frames{solve})",
                         tuned.source, frames.name
                     );
                     return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
                 }
                 Some(reason) => {
                     why_not = format!(
-                        " (not the tuned {}: the skeleton has its names, but {reason})",
+                        " (not the tuned {}: the skeleton has its names, but {reason}{solve})",
                         tuned.source
                     );
                 }

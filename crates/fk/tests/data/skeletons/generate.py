@@ -43,12 +43,12 @@ ARMS = {
 }
 
 
-def point(key, side="l", arms="down"):
-    """Body point `key` on `side` ('l' or 'r'; ignored for the trunk). Extra points near a
-    hand (`hand_end:tip`) move with the arm pose."""
+def point(key, side="l", arms="down", body=None):
+    """Body point `key` on `side` ('l' or 'r'; ignored for the trunk) of `body` (`BODY` when
+    None). Extra points near a hand (`hand_end:tip`) move with the arm pose."""
     base = key.split(":")[0]
-    p = BODY[key]
-    if ARMS[arms] and base in ARMS[arms]:
+    p = (body or BODY)[key]
+    if body is None and ARMS[arms] and base in ARMS[arms]:
         p = add(ARMS[arms][base], sub(p, BODY[base]))
     return (-p[0], p[1], p[2]) if side == "r" else p
 
@@ -90,60 +90,80 @@ def euler_zxy(m):
     return tuple(math.degrees(v) for v in (z, x, y))
 
 
+def euler_zyx(m):
+    """Degrees (z, y, x) with m = Rz · Ry · Rx (channels `Zrotation Yrotation Xrotation`, as
+    HumanML3D's converters write them)."""
+    y = math.asin(max(-1.0, min(1.0, -m[2][0])))
+    x = math.atan2(m[2][1], m[2][2])
+    z = math.atan2(m[1][0], m[0][0])
+    return tuple(math.degrees(v) for v in (z, y, x))
+
+
+EULER = {"zxy": euler_zxy, "zyx": euler_zyx}
+ROTATION_CHANNELS = {"zxy": "Zrotation Xrotation Yrotation", "zyx": "Zrotation Yrotation Xrotation"}
+
 # Body → file axes: columns are where the body's left, up and forward go.
 Y_UP = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]  # BVH norm: facing +Z, left = +X
 Z_UP_FACE_Y = [[-1, 0, 0], [0, 0, 1], [0, 1, 0]]  # 3ds Max / Unreal: up +Z, facing +Y
 Z_UP_FACE_NEG_Y = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]  # Blender / MakeHuman: up +Z, facing -Y
 
 # Gaits: stride frequency (Hz), hip swing and knee flexion amplitudes (degrees), arm swing,
-# elbow flexion, vertical bounce (m, for flight phases) and duration (s).
+# elbow flexion, vertical bounce (m, for flight phases), duration (s) and frame rate (30 fps
+# unless said; HumanML3D's is 20).
 GAITS = {
     "walk": dict(freq=0.9, hip=24.0, hip_bias=4.0, knee_stance=8.0, knee_swing=55.0, ankle=12.0,
                  arm=18.0, elbow=15.0, bounce=0.0, seconds=6.0),
+    "walk20": dict(freq=0.9, hip=24.0, hip_bias=4.0, knee_stance=8.0, knee_swing=55.0,
+                   ankle=12.0, arm=18.0, elbow=15.0, bounce=0.0, seconds=3.0, fps=20.0),
     "sprint": dict(freq=1.45, hip=38.0, hip_bias=6.0, knee_stance=15.0, knee_swing=105.0,
                    ankle=20.0, arm=45.0, elbow=85.0, bounce=0.05, seconds=5.0),
 }
 
 
-def gait_pose(g, phase):
+def gait_pose(g, phase, arms_down=0.0):
     """Per (part, side): the joint's rotation in body axes at gait phase `phase` (radians of the
-    left leg's cycle; the right leg half a cycle later, each arm with the other leg)."""
+    left leg's cycle; the right leg half a cycle later, each arm with the other leg).
+    `arms_down`: degrees that bring the upper arms from the zero pose down to the sides (a
+    T zero pose: about 80), so that every frame turns the shoulders and elbows."""
     out = {}
     for side, offset in (("l", 0.0), ("r", math.pi)):
         p = phase + offset
         swing = max(0.0, math.cos(p))  # the hip moving forward: the swing phase
+        down = rot("z", -arms_down if side == "l" else arms_down)
         out[("thigh", side)] = rot("x", -(g["hip"] * math.sin(p) + g["hip_bias"]))
         out[("shin", side)] = rot("x", g["knee_stance"] + g["knee_swing"] * swing ** 2)
         out[("foot", side)] = rot("x", -g["ankle"] * math.sin(p + 0.6))
-        out[("upper_arm", side)] = rot("x", g["arm"] * math.sin(p))
-        out[("forearm", side)] = rot("x", -(g["elbow"] + 0.3 * g["elbow"] * swing))
+        out[("upper_arm", side)] = mat_mul(rot("x", g["arm"] * math.sin(p)), down)
+        elbow = rot("x", -(g["elbow"] + 0.3 * g["elbow"] * swing))
+        out[("forearm", side)] = mat_mul(mat_mul(transpose(down), elbow), down)
     return out
 
 
-def foot_points(pose, side):
+def foot_points(pose, side, body=None):
     """Ankle and toe (body coordinates, pelvis at its rest point) under `pose`."""
-    hip = point("thigh", side)
+    hip = point("thigh", side, body=body)
     r = pose[("thigh", side)]
-    knee = add(hip, mat_vec(r, sub(point("shin", side), hip)))
+    knee = add(hip, mat_vec(r, sub(point("shin", side, body=body), hip)))
     r = mat_mul(r, pose[("shin", side)])
-    ankle = add(knee, mat_vec(r, sub(point("foot", side), point("shin", side))))
+    ankle = add(knee, mat_vec(r, sub(point("foot", side, body=body), point("shin", side, body=body))))
     r = mat_mul(r, pose[("foot", side)])
-    toe = add(ankle, mat_vec(r, sub(point("toe", side), point("foot", side))))
+    toe = add(ankle, mat_vec(r, sub(point("toe", side, body=body), point("foot", side, body=body))))
     return ankle, toe
 
 
-def gait_frames(name):
-    """Root translation (body axes), yaw (degrees) and joint rotations per frame, 30 fps: the
-    lowest foot point on the floor, the stance foot not sliding, a slow turn to the left."""
+def gait_frames(name, body=None, arms_down=0.0):
+    """Root translation (body axes), yaw (degrees) and joint rotations per frame (the gait's
+    `fps`, 30 unless it says): the lowest foot point on the floor, the stance foot not
+    sliding, a slow turn to the left."""
     g = GAITS[name]
-    fps = 30.0
+    fps = g.get("fps", 30.0)
     frames = []
     forward, speed = 0.0, None
     previous = None
     for k in range(int(g["seconds"] * fps)):
         phase = 2 * math.pi * g["freq"] * k / fps
-        pose = gait_pose(g, phase)
-        feet = {s: foot_points(pose, s) for s in "lr"}
+        pose = gait_pose(g, phase, arms_down)
+        feet = {s: foot_points(pose, s, body) for s in "lr"}
         # Height above the floor of each foot: ankle 8 cm, toe 2 cm when standing.
         low = {s: min(feet[s][0][1] - 0.08, feet[s][1][1] - 0.02) for s in "lr"}
         stance = min(low, key=low.get)
@@ -156,22 +176,25 @@ def gait_frames(name):
         elif speed is not None:
             forward += speed
         previous = (stance, ahead)
-        root = add(point("pelvis"), (0.0, lift, forward))
+        root = add(point("pelvis", body=body), (0.0, lift, forward))
         frames.append((root, 5.0 * k / fps, pose))
     return frames
 
 
 def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying=False,
-          gait=None):
+          gait=None, body=None, arms_down=0.0, root_offset=None, rotation_order="zxy", zero_ends=False):
     """`joints`: (name, parent or None, body point key, side); End Sites are named None and
-    placed at their point. `shins`: names of the joints that bend as knees. `gait`: a whole
-    gait cycle (see `GAITS`) instead of the four frames."""
+    placed at their point (at the joint itself with `zero_ends`). `shins`: names of the joints
+    that bend as knees. `gait`: a whole gait cycle (see `GAITS`) instead of the four frames.
+    `body`: the body's points (`BODY` when None), `arms_down` as in `gait_pose`.
+    `root_offset`: the root's OFFSET (body coordinates) when it is not where the root stands;
+    its position channels still say where it is. `rotation_order`: "zxy" or "zyx"."""
     axes = mat_mul(rot("y", 0) if axes is None else axes, rot("y", yaw))
     # A zero pose lying on its back along +X: offsets turned by r0, undone by the root.
     r0 = rot("z", -90) if lying else rot("x", 0)
     pos = {}
     for name, parent, key, side in joints:
-        pos[(name, parent)] = point(key, side, arms)
+        pos[(name, parent)] = point(key, side, arms, body)
     lines = ["HIERARCHY"]
     children = {}
     for j in joints:
@@ -182,6 +205,10 @@ def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying
         name, parent, key, side = joint
         p = pos[(name, parent)]
         offset = p if parent is None else sub(p, parent_point)
+        if parent is None and root_offset is not None:
+            offset = root_offset
+        if name is None and zero_ends:
+            offset = (0.0, 0.0, 0.0)
         offset = mat_vec(axes, offset)
         if parent is not None:
             offset = mat_vec(r0, offset)
@@ -195,9 +222,9 @@ def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying
         lines.append(pad + "  OFFSET " + " ".join(f"{v:.6f}" for v in offset))
         if name is not None:
             if parent is None:
-                chans = "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
+                chans = "6 Xposition Yposition Zposition " + ROTATION_CHANNELS[rotation_order]
             else:
-                chans = "3 Zrotation Xrotation Yrotation"
+                chans = "3 " + ROTATION_CHANNELS[rotation_order]
             lines.append(pad + "  CHANNELS " + chans)
             order.append(name)
             for child in children.get(name, []):
@@ -207,16 +234,17 @@ def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying
     emit(children[None][0], 0, None)
     rows = []
     parts = {name: (key.split(":")[0], side) for name, _, key, side in joints if name}
-    for root, turn_deg, pose in (gait_frames(gait) if gait else []):
+    euler = EULER[rotation_order]
+    for root, turn_deg, pose in (gait_frames(gait, body, arms_down) if gait else []):
         row = []
         for name in order:
             if name == order[0]:
                 row += [v / unit for v in mat_vec(axes, root)]
                 turn = mat_mul(mat_mul(axes, rot("y", turn_deg)), transpose(axes))
-                row += euler_zxy(mat_mul(turn, transpose(r0)))
+                row += euler(mat_mul(turn, transpose(r0)))
             elif parts[name] in pose:
                 local = mat_mul(mat_mul(axes, pose[parts[name]]), transpose(axes))
-                row += euler_zxy(mat_mul(mat_mul(r0, local), transpose(r0)))
+                row += euler(mat_mul(mat_mul(r0, local), transpose(r0)))
             else:
                 row += [0.0, 0.0, 0.0]
         rows.append(" ".join(f"{v:.6f}" for v in row))
@@ -227,14 +255,15 @@ def write(path, joints, shins, axes=Y_UP, unit=0.01, arms="down", yaw=0.0, lying
                 root = add(point(joints[0][2]), (0.0, 0.0, 0.1 * k))
                 row += [v / unit for v in mat_vec(axes, root)]
                 turn = mat_mul(mat_mul(axes, rot("y", 5.0 * k)), transpose(axes))
-                row += euler_zxy(mat_mul(turn, transpose(r0)))
+                row += euler(mat_mul(turn, transpose(r0)))
             elif name in shins:
                 bend = mat_mul(mat_mul(axes, rot("x", 10.0 + 8.0 * k)), transpose(axes))
-                row += euler_zxy(mat_mul(mat_mul(r0, bend), transpose(r0)))
+                row += euler(mat_mul(mat_mul(r0, bend), transpose(r0)))
             else:
                 row += [0.0, 0.0, 0.0]
         rows.append(" ".join(f"{v:.6f}" for v in row))
-    lines += ["MOTION", f"Frames: {len(rows)}", "Frame Time: 0.033333"] + rows
+    fps = GAITS[gait].get("fps", 30.0) if gait else 30.0
+    lines += ["MOTION", f"Frames: {len(rows)}", f"Frame Time: {1.0 / fps:.6f}"] + rows
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
 
@@ -576,6 +605,69 @@ def biovision():
     return joints + out, ["LeftLowLeg", "RightLowLeg"]
 
 
+# SMPL's template body (joint positions of the mean shape, rounded to 1 cm; x = left, y = up,
+# z = forward, feet on the floor), in its T zero pose. HumanML3D's "joints to BVH" converters
+# (momask's and T2M-GPT's `joints2bvh`, `smpl2bvh`) take their OFFSETs from it.
+SMPL_BODY = {
+    "pelvis": (0.0, 0.94, 0.03), "spine": (0.0, 1.05, 0.0), "spine:2": (0.0, 1.18, 0.0),
+    "chest": (0.0, 1.24, 0.03), "neck": (0.0, 1.45, -0.02), "head": (0.0, 1.52, 0.04),
+    "clavicle": (0.08, 1.36, -0.01), "upper_arm": (0.17, 1.39, -0.02),
+    "forearm": (0.43, 1.38, -0.04), "hand": (0.68, 1.39, -0.04),
+    "thigh": (0.07, 0.85, 0.02), "shin": (0.10, 0.47, 0.02), "foot": (0.09, 0.08, -0.03),
+    "toe": (0.12, 0.02, 0.09),
+}
+# Where the template's pelvis is in the body model's own coordinates: the root OFFSET these
+# converters write, while the root's position channels carry the pelvis's world position.
+SMPL_PELVIS_IN_MODEL = (0.0, -0.22, 0.03)
+
+
+def smpl_22(names):
+    """SMPL's first 22 joints as HumanML3D has them (no hands: the wrists end the arms, the
+    toes (`L_Foot`) the legs, the head the trunk, each with an End Site at the joint), written
+    children in SMPL's joint order: hips before the spine, the neck before the collars.
+    `names[key]` for the trunk, `names[(key, side)]` for the limbs."""
+    joints = [(names["pelvis"], None, "pelvis", "l")]
+    for s in "lr":
+        parent = names["pelvis"]
+        for key in ("thigh", "shin", "foot", "toe"):
+            joints.append((names[(key, s)], parent, key, s))
+            parent = names[(key, s)]
+        joints.append((None, parent, "toe", s))
+    parent = names["pelvis"]
+    for key in ("spine", "spine:2", "chest", "neck", "head"):
+        joints.append((names[key], parent, key, "l"))
+        parent = names[key]
+    joints.append((None, parent, "head", "l"))
+    for s in "lr":
+        parent = names["chest"]
+        for key in ("clavicle", "upper_arm", "forearm", "hand"):
+            joints.append((names[(key, s)], parent, key, s))
+            parent = names[(key, s)]
+        joints.append((None, parent, "hand", s))
+    return joints, [names[("shin", "l")], names[("shin", "r")]]
+
+
+def humanml3d_smpl():
+    # SMPL's own joint names (`smpl2bvh`, HumanML3D's joint list: Pelvis, L_Hip, Spine1, …).
+    names = sided("{S}_{W}", {
+        "clavicle": "Collar", "upper_arm": "Shoulder", "forearm": "Elbow", "hand": "Wrist",
+        "thigh": "Hip", "shin": "Knee", "foot": "Ankle", "toe": "Foot"})
+    names.update({"pelvis": "Pelvis", "spine": "Spine1", "spine:2": "Spine2",
+                  "chest": "Spine3", "neck": "Neck", "head": "Head"})
+    return smpl_22(names)
+
+
+def hik_joints2bvh():
+    # HumanIK names on SMPL's 22 joints, metres (momask's `joints2bvh` template names the toe
+    # `LeftToe`; HumanIK's own name is `LeftToeBase`).
+    names = sided("{Side}{W}", {
+        "clavicle": "Shoulder", "upper_arm": "Arm", "forearm": "ForeArm", "hand": "Hand",
+        "thigh": "UpLeg", "shin": "Leg", "foot": "Foot", "toe": "ToeBase"})
+    names.update({"pelvis": "Hips", "spine": "Spine", "spine:2": "Spine1", "chest": "Spine2",
+                  "neck": "Neck", "head": "Head"})
+    return smpl_22(names)
+
+
 def unrecognisable():
     # A robot arm: one chain, nothing like a body.
     joints = [("base", None, "pelvis", "l"), ("link1", "base", "spine", "l"),
@@ -624,6 +716,13 @@ def main():
     write("makehuman_zup_decimetres_walk.bvh", *makehuman(), axes=Z_UP_FACE_NEG_Y, unit=0.1,
           gait="walk")
     write("biovision_inches_sprint.bvh", *biovision(), unit=0.0254, gait="sprint")
+    # HumanML3D's converters: metres, Y up, SMPL's T zero pose (every frame turns the arms
+    # down), the root OFFSET where SMPL's model has its pelvis, `Zrotation Yrotation
+    # Xrotation`, End Sites at their joints, 20 fps.
+    humanml3d = dict(unit=1.0, gait="walk20", body=SMPL_BODY, arms_down=80.0,
+                     root_offset=SMPL_PELVIS_IN_MODEL, rotation_order="zyx", zero_ends=True)
+    write("humanml3d_smpl_walk.bvh", *humanml3d_smpl(), **humanml3d)
+    write("hik_metres_walk.bvh", *hik_joints2bvh(), **humanml3d)
 
 
 if __name__ == "__main__":
