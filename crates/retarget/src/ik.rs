@@ -38,6 +38,7 @@ use crate::Error;
 
 mod bounds;
 mod qp_step;
+mod task_terms;
 mod trajectory_step;
 
 /// Fraction of a joint speed limit the solver allows itself ([`Solver::set_speed_limits`]).
@@ -155,8 +156,10 @@ struct TaskWork {
     /// Error at the current configuration, and the body's pose it was computed from.
     err: nalgebra::Vector6<f64>,
     frame: Pose,
-    /// Weighted Jacobian, one 6-column per dof of `dofs`.
-    wjac: Vec<[f64; 6]>,
+    /// Runs of consecutive ids in `dofs` (`task_terms::runs`).
+    runs: Vec<(usize, usize)>,
+    /// Weighted Jacobian, six rows of one entry per dof of `dofs`.
+    wjac: task_terms::Rows,
 }
 
 /// A range-limited hinge or slide joint: its dof, qpos address and range.
@@ -247,7 +250,8 @@ impl<'m> Solver<'m> {
                     spec: *spec,
                     cost: [p, p, p, r, r, r],
                     scale: [1.0; 6],
-                    wjac: vec![[0.0; 6]; dofs.len()],
+                    wjac: std::array::from_fn(|_| vec![0.0; dofs.len()]),
+                    runs: task_terms::runs(&dofs),
                     dofs,
                     err: nalgebra::Vector6::zeros(),
                     frame: Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: nalgebra::Vector3::zeros() },
@@ -523,46 +527,26 @@ impl<'m> Solver<'m> {
             Arithmetic::Lean => lie::se3_jlog_at(&task.err),
         };
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
-        let rt = self.data.xmat[body].transpose();
+        let xmat = self.data.xmat[body];
         let task = &mut self.stages[s][k];
         let w: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r]);
-        let column = |d: usize| {
-            let jp = nalgebra::Vector3::new(self.jacp[d], self.jacp[nv + d], self.jacp[2 * nv + d]);
-            let jr = nalgebra::Vector3::new(self.jacr[d], self.jacr[nv + d], self.jacr[2 * nv + d]);
-            (jp, jr)
-        };
+        let jac = (&self.jacp[..], &self.jacr[..], nv);
         match self.options.arithmetic {
             Arithmetic::Mink => {
-                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
-                    let (jp, jr) = column(d);
-                    let (bp, br) = (rt * jp, rt * jr);
-                    let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
-                    let j = -(jlog * local);
-                    *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
-                }
+                task_terms::mink_rows(&jlog, &xmat, &w, jac, &task.dofs, &mut task.wjac)
             }
             Arithmetic::Lean => {
-                // Jlog = [[A, B], [0, A]]: fold the body rotation into its blocks once.
-                let a = jlog.fixed_view::<3, 3>(0, 0) * rt;
-                let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
-                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
-                    let (jp, jr) = column(d);
-                    let (top, bottom) = (a * jp + b * jr, a * jr);
-                    let j = [top.x, top.y, top.z, bottom.x, bottom.y, bottom.z];
-                    *col = std::array::from_fn(|r| -(w[r] * j[r]));
-                }
+                task_terms::lean_rows(&jlog, &xmat, &w, jac, &task.dofs, &mut task.wjac)
             }
         }
-        let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
+        let we: [f64; 6] = std::array::from_fn(|r| w[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
-        // Upper triangle only (dofs ascending); mirrored for the box solver.
-        for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
-            self.qp.c[da] -= dot6(&we, col_a);
-            let row = &mut self.qp.h[da * nv..(da + 1) * nv];
-            for (col_b, &db) in task.wjac[a..].iter().zip(&task.dofs[a..]) {
-                row[db] += dot6(col_a, col_b);
-            }
+        for (a, &da) in task.dofs.iter().enumerate() {
+            let col: [f64; 6] = std::array::from_fn(|r| task.wjac[r][a]);
+            self.qp.c[da] -= dot6(&we, &col);
         }
+        // Upper triangle only (dofs ascending); mirrored for the box solver.
+        task_terms::add_gram(&task.wjac, &w, &task.dofs, &task.runs, nv, &mut self.qp.h);
         self.options.lm_damping * mu
     }
 
