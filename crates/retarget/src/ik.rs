@@ -217,6 +217,8 @@ pub struct Solver<'m> {
     next: Option<Vec<f64>>,
     /// Geoms held above the floor in this frame ([`Solver::set_raised_geoms`]).
     raised: Vec<(usize, f64)>,
+    /// Whether `data`'s geoms and sites are at its bodies' poses ([`Solver::take_step`]).
+    geoms_placed: bool,
 }
 
 impl<'m> Solver<'m> {
@@ -309,6 +311,7 @@ impl<'m> Solver<'m> {
             extra_c: Vec::new(),
             next: None,
             raised: Vec::new(),
+            geoms_placed: true,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
         Ok(solver)
@@ -376,6 +379,7 @@ impl<'m> Solver<'m> {
         self.qpos.copy_from_slice(qpos);
         self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
+        self.geoms_placed = true;
         Ok(())
     }
 
@@ -410,6 +414,7 @@ impl<'m> Solver<'m> {
             steps.push(n);
             error = e;
         }
+        self.place_geoms();
         let (pos_error, rot_error) = self.tracking_errors(targets);
         Ok(FrameDiagnostics {
             steps,
@@ -507,11 +512,26 @@ impl<'m> Solver<'m> {
         }
     }
 
-    /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics.
+    /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics. Without
+    /// constraints nothing in a step reads the geoms and sites: they are placed once the
+    /// frame is solved ([`Solver::place_geoms`]).
     fn take_step(&mut self) {
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
         self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
-        self.model.kinematics(&self.qpos, &mut self.data);
+        if self.constraints.is_empty() {
+            self.geoms_placed = !self.model.body_kinematics(&self.qpos, &mut self.data);
+        } else {
+            self.model.kinematics(&self.qpos, &mut self.data);
+        }
+    }
+
+    /// Places the geoms and sites at the bodies' poses if a step left them behind, so that
+    /// [`Solver::data`] is the whole kinematics of [`Solver::qpos`].
+    fn place_geoms(&mut self) {
+        if !self.geoms_placed {
+            self.model.place_geoms_and_sites(&mut self.data);
+            self.geoms_placed = true;
+        }
     }
 
     /// Adds task `k`'s `J̃ᵀJ̃` to H and `−ẽᵀJ̃` to c; returns its μ.
