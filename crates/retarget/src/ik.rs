@@ -409,8 +409,13 @@ impl<'m> Solver<'m> {
         self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
         let mut error = 0.0;
+        // The last stage solved: its tasks' errors are at the current configuration.
+        let mut current = None;
         for s in 0..self.stages.len() {
-            let (n, e) = self.solve_stage(s, targets, dt);
+            let (n, e) = self.solve_stage(s, targets, dt, current);
+            if n > 0 {
+                current = Some(s);
+            }
             steps.push(n);
             error = e;
         }
@@ -428,11 +433,18 @@ impl<'m> Solver<'m> {
         })
     }
 
-    fn solve_stage(&mut self, s: usize, targets: &[Pose], dt: f64) -> (usize, f64) {
+    /// Stage `s`'s steps; `current`: a stage whose errors are at the current configuration.
+    fn solve_stage(
+        &mut self,
+        s: usize,
+        targets: &[Pose],
+        dt: f64,
+        current: Option<usize>,
+    ) -> (usize, f64) {
         if self.stages[s].is_empty() {
             return (0, 0.0);
         }
-        let mut current = self.stage_error(s, targets);
+        let mut current = self.stage_error_from(s, targets, current);
         self.step(s, targets, dt);
         let mut next = self.stage_error(s, targets);
         let mut steps = 1;
@@ -461,11 +473,25 @@ impl<'m> Solver<'m> {
 
     /// Updates every task's error at the current configuration; returns the norm of all.
     fn stage_error(&mut self, s: usize, targets: &[Pose]) -> f64 {
+        self.stage_error_from(s, targets, None)
+    }
+
+    /// [`Solver::stage_error`], where stage `from`'s errors are at the current configuration
+    /// (and targets): a task on the same body and target takes its error and pose from there
+    /// (GMR's two tables track the same bodies, so a frame's second stage starts from the
+    /// first one's last errors).
+    fn stage_error_from(&mut self, s: usize, targets: &[Pose], from: Option<usize>) -> f64 {
         let mut sum = 0.0;
         for k in 0..self.stages[s].len() {
             let spec = self.stages[s][k].spec;
-            let frame = self.body_pose(spec.body);
-            let e = lie::rminus(&targets[spec.target], &frame);
+            let known = from.and_then(|f| {
+                let same = |t: &&TaskWork| (t.spec.body, t.spec.target) == (spec.body, spec.target);
+                self.stages[f].iter().find(same).map(|t| (t.err, t.frame))
+            });
+            let (e, frame) = known.unwrap_or_else(|| {
+                let frame = self.body_pose(spec.body);
+                (lie::rminus(&targets[spec.target], &frame), frame)
+            });
             sum += e.norm_squared();
             (self.stages[s][k].err, self.stages[s][k].frame) = (e, frame);
         }
