@@ -57,7 +57,17 @@ pub(super) fn mink_rows(
     let j = |r: usize, c: usize| jlog[(r, c)];
     for (i, &d) in dofs.iter().enumerate() {
         let (jp, jr) = column(jacp, jacr, nv, d);
-        let (bp, br) = (mat3_vec(&rt, &jp), mat3_vec(&rt, &jr));
+        let bp = mat3_vec(&rt, &jp);
+        if jr == [0.0; 3] {
+            // A translation: `Rᵀ jr` and every product with it are zeros.
+            for r in 0..3 {
+                let top = j(r, 0) * bp[0] + j(r, 1) * bp[1] + j(r, 2) * bp[2];
+                rows[r][i] = w[r] * -top;
+                rows[r + 3][i] = 0.0;
+            }
+            continue;
+        }
+        let br = mat3_vec(&rt, &jr);
         for r in 0..3 {
             let top = j(r, 0) * bp[0]
                 + j(r, 1) * bp[1]
@@ -87,7 +97,16 @@ pub(super) fn lean_rows(
     let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
     for (i, &d) in dofs.iter().enumerate() {
         let (jp, jr) = column(jacp, jacr, nv, d);
-        let (top_a, top_b, bottom) = (mat3_vec(&a, &jp), mat3_vec(&b, &jr), mat3_vec(&a, &jr));
+        let top_a = mat3_vec(&a, &jp);
+        if jr == [0.0; 3] {
+            // A translation: the products with `jr` are zeros.
+            for r in 0..3 {
+                rows[r][i] = -(w[r] * top_a[r]);
+                rows[r + 3][i] = 0.0;
+            }
+            continue;
+        }
+        let (top_b, bottom) = (mat3_vec(&b, &jr), mat3_vec(&a, &jr));
         for r in 0..3 {
             rows[r][i] = -(w[r] * (top_a[r] + top_b[r]));
             rows[r + 3][i] = -(w[r + 3] * bottom[r]);
