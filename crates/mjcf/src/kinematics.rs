@@ -93,11 +93,21 @@ impl Model {
     ///
     /// A `qpos` shorter than `nq` leaves `data` unchanged (library code does not panic).
     pub fn kinematics(&self, qpos: &[f64], data: &mut Data) {
+        if self.body_kinematics(qpos, data) {
+            self.place_geoms_and_sites(data);
+        }
+    }
+
+    /// [`Model::kinematics`] of the bodies, joint axes and anchors alone, the geoms and sites
+    /// left where they were (for a caller that reads only those, and places the geoms and
+    /// sites with [`Model::place_geoms_and_sites`] when it needs them). `false` when `qpos`
+    /// is shorter than `nq` (then `data` is unchanged).
+    pub fn body_kinematics(&self, qpos: &[f64], data: &mut Data) -> bool {
         if qpos.len() < self.nq
             || data.xpos.len() != self.bodies.len()
             || data.dof_axis.len() != self.nv
         {
-            return;
+            return false;
         }
         for (i, body) in self.bodies.iter().enumerate().skip(1) {
             let p = body.parent;
@@ -156,10 +166,12 @@ impl Model {
                 self.dof_frames(body.jnt_adr..last, &xmat, data);
             }
         }
-        self.place_geoms_and_sites(data);
+        true
     }
 
-    fn place_geoms_and_sites(&self, data: &mut Data) {
+    /// World poses of the geoms and sites from their bodies' (the last part of
+    /// [`Model::kinematics`]).
+    pub fn place_geoms_and_sites(&self, data: &mut Data) {
         for (g, geom) in self.geoms.iter().enumerate() {
             let (p, r) = (data.xpos[geom.body], data.xmat[geom.body]);
             data.geom_xpos[g] = p + r * geom.pos;

@@ -38,6 +38,7 @@ use crate::Error;
 
 mod bounds;
 mod qp_step;
+mod task_terms;
 mod trajectory_step;
 
 /// Fraction of a joint speed limit the solver allows itself ([`Solver::set_speed_limits`]).
@@ -155,8 +156,10 @@ struct TaskWork {
     /// Error at the current configuration, and the body's pose it was computed from.
     err: nalgebra::Vector6<f64>,
     frame: Pose,
-    /// Weighted Jacobian, one 6-column per dof of `dofs`.
-    wjac: Vec<[f64; 6]>,
+    /// Runs of consecutive ids in `dofs` (`task_terms::runs`).
+    runs: Vec<(usize, usize)>,
+    /// Weighted Jacobian, six rows of one entry per dof of `dofs`.
+    wjac: task_terms::Rows,
 }
 
 /// A range-limited hinge or slide joint: its dof, qpos address and range.
@@ -214,6 +217,8 @@ pub struct Solver<'m> {
     next: Option<Vec<f64>>,
     /// Geoms held above the floor in this frame ([`Solver::set_raised_geoms`]).
     raised: Vec<(usize, f64)>,
+    /// Whether `data`'s geoms and sites are at its bodies' poses ([`Solver::take_step`]).
+    geoms_placed: bool,
 }
 
 impl<'m> Solver<'m> {
@@ -247,7 +252,8 @@ impl<'m> Solver<'m> {
                     spec: *spec,
                     cost: [p, p, p, r, r, r],
                     scale: [1.0; 6],
-                    wjac: vec![[0.0; 6]; dofs.len()],
+                    wjac: std::array::from_fn(|_| vec![0.0; dofs.len()]),
+                    runs: task_terms::runs(&dofs),
                     dofs,
                     err: nalgebra::Vector6::zeros(),
                     frame: Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: nalgebra::Vector3::zeros() },
@@ -305,6 +311,7 @@ impl<'m> Solver<'m> {
             extra_c: Vec::new(),
             next: None,
             raised: Vec::new(),
+            geoms_placed: true,
         };
         solver.model.kinematics(&solver.qpos, &mut solver.data);
         Ok(solver)
@@ -372,6 +379,7 @@ impl<'m> Solver<'m> {
         self.qpos.copy_from_slice(qpos);
         self.rows_made = false;
         self.model.kinematics(&self.qpos, &mut self.data);
+        self.geoms_placed = true;
         Ok(())
     }
 
@@ -401,11 +409,17 @@ impl<'m> Solver<'m> {
         self.relaxed_steps = 0;
         let mut steps = Vec::with_capacity(self.stages.len());
         let mut error = 0.0;
+        // The last stage solved: its tasks' errors are at the current configuration.
+        let mut current = None;
         for s in 0..self.stages.len() {
-            let (n, e) = self.solve_stage(s, targets, dt);
+            let (n, e) = self.solve_stage(s, targets, dt, current);
+            if n > 0 {
+                current = Some(s);
+            }
             steps.push(n);
             error = e;
         }
+        self.place_geoms();
         let (pos_error, rot_error) = self.tracking_errors(targets);
         Ok(FrameDiagnostics {
             steps,
@@ -419,11 +433,18 @@ impl<'m> Solver<'m> {
         })
     }
 
-    fn solve_stage(&mut self, s: usize, targets: &[Pose], dt: f64) -> (usize, f64) {
+    /// Stage `s`'s steps; `current`: a stage whose errors are at the current configuration.
+    fn solve_stage(
+        &mut self,
+        s: usize,
+        targets: &[Pose],
+        dt: f64,
+        current: Option<usize>,
+    ) -> (usize, f64) {
         if self.stages[s].is_empty() {
             return (0, 0.0);
         }
-        let mut current = self.stage_error(s, targets);
+        let mut current = self.stage_error_from(s, targets, current);
         self.step(s, targets, dt);
         let mut next = self.stage_error(s, targets);
         let mut steps = 1;
@@ -452,11 +473,25 @@ impl<'m> Solver<'m> {
 
     /// Updates every task's error at the current configuration; returns the norm of all.
     fn stage_error(&mut self, s: usize, targets: &[Pose]) -> f64 {
+        self.stage_error_from(s, targets, None)
+    }
+
+    /// [`Solver::stage_error`], where stage `from`'s errors are at the current configuration
+    /// (and targets): a task on the same body and target takes its error and pose from there
+    /// (GMR's two tables track the same bodies, so a frame's second stage starts from the
+    /// first one's last errors).
+    fn stage_error_from(&mut self, s: usize, targets: &[Pose], from: Option<usize>) -> f64 {
         let mut sum = 0.0;
         for k in 0..self.stages[s].len() {
             let spec = self.stages[s][k].spec;
-            let frame = self.body_pose(spec.body);
-            let e = lie::rminus(&targets[spec.target], &frame);
+            let known = from.and_then(|f| {
+                let same = |t: &&TaskWork| (t.spec.body, t.spec.target) == (spec.body, spec.target);
+                self.stages[f].iter().find(same).map(|t| (t.err, t.frame))
+            });
+            let (e, frame) = known.unwrap_or_else(|| {
+                let frame = self.body_pose(spec.body);
+                (lie::rminus(&targets[spec.target], &frame), frame)
+            });
             sum += e.norm_squared();
             (self.stages[s][k].err, self.stages[s][k].frame) = (e, frame);
         }
@@ -503,11 +538,26 @@ impl<'m> Solver<'m> {
         }
     }
 
-    /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics.
+    /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics. Without
+    /// constraints nothing in a step reads the geoms and sites: they are placed once the
+    /// frame is solved ([`Solver::place_geoms`]).
     fn take_step(&mut self) {
         self.model.integrate_pos(&mut self.qpos, &self.dq, 1.0);
         self.moved.iter_mut().zip(&self.dq).for_each(|(m, d)| *m += d);
-        self.model.kinematics(&self.qpos, &mut self.data);
+        if self.constraints.is_empty() {
+            self.geoms_placed = !self.model.body_kinematics(&self.qpos, &mut self.data);
+        } else {
+            self.model.kinematics(&self.qpos, &mut self.data);
+        }
+    }
+
+    /// Places the geoms and sites at the bodies' poses if a step left them behind, so that
+    /// [`Solver::data`] is the whole kinematics of [`Solver::qpos`].
+    fn place_geoms(&mut self) {
+        if !self.geoms_placed {
+            self.model.place_geoms_and_sites(&mut self.data);
+            self.geoms_placed = true;
+        }
     }
 
     /// Adds task `k`'s `J̃ᵀJ̃` to H and `−ẽᵀJ̃` to c; returns its μ.
@@ -523,46 +573,26 @@ impl<'m> Solver<'m> {
             Arithmetic::Lean => lie::se3_jlog_at(&task.err),
         };
         self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
-        let rt = self.data.xmat[body].transpose();
+        let xmat = self.data.xmat[body];
         let task = &mut self.stages[s][k];
         let w: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r]);
-        let column = |d: usize| {
-            let jp = nalgebra::Vector3::new(self.jacp[d], self.jacp[nv + d], self.jacp[2 * nv + d]);
-            let jr = nalgebra::Vector3::new(self.jacr[d], self.jacr[nv + d], self.jacr[2 * nv + d]);
-            (jp, jr)
-        };
+        let jac = (&self.jacp[..], &self.jacr[..], nv);
         match self.options.arithmetic {
             Arithmetic::Mink => {
-                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
-                    let (jp, jr) = column(d);
-                    let (bp, br) = (rt * jp, rt * jr);
-                    let local = nalgebra::Vector6::new(bp[0], bp[1], bp[2], br[0], br[1], br[2]);
-                    let j = -(jlog * local);
-                    *col = std::array::from_fn(|r| task.cost[r] * task.scale[r] * j[r]);
-                }
+                task_terms::mink_rows(&jlog, &xmat, &w, jac, &task.dofs, &mut task.wjac)
             }
             Arithmetic::Lean => {
-                // Jlog = [[A, B], [0, A]]: fold the body rotation into its blocks once.
-                let a = jlog.fixed_view::<3, 3>(0, 0) * rt;
-                let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
-                for (col, &d) in task.wjac.iter_mut().zip(&task.dofs) {
-                    let (jp, jr) = column(d);
-                    let (top, bottom) = (a * jp + b * jr, a * jr);
-                    let j = [top.x, top.y, top.z, bottom.x, bottom.y, bottom.z];
-                    *col = std::array::from_fn(|r| -(w[r] * j[r]));
-                }
+                task_terms::lean_rows(&jlog, &xmat, &w, jac, &task.dofs, &mut task.wjac)
             }
         }
-        let we: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r] * (-task.err[r]));
+        let we: [f64; 6] = std::array::from_fn(|r| w[r] * (-task.err[r]));
         let mu: f64 = we.iter().map(|w| w * w).sum();
-        // Upper triangle only (dofs ascending); mirrored for the box solver.
-        for (a, (col_a, &da)) in task.wjac.iter().zip(&task.dofs).enumerate() {
-            self.qp.c[da] -= dot6(&we, col_a);
-            let row = &mut self.qp.h[da * nv..(da + 1) * nv];
-            for (col_b, &db) in task.wjac[a..].iter().zip(&task.dofs[a..]) {
-                row[db] += dot6(col_a, col_b);
-            }
+        for (a, &da) in task.dofs.iter().enumerate() {
+            let col: [f64; 6] = std::array::from_fn(|r| task.wjac[r][a]);
+            self.qp.c[da] -= dot6(&we, &col);
         }
+        // Upper triangle only (dofs ascending); mirrored for the box solver.
+        task_terms::add_gram(&task.wjac, &w, &task.dofs, &task.runs, nv, &mut self.qp.h);
         self.options.lm_damping * mu
     }
 

@@ -113,26 +113,52 @@ fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v[2], v[1], v[2], 0.0, -v[0], -v[1], v[0], 0.0)
 }
 
-/// SE(3) logarithm: `[V⁻¹(ω) t; ω]`.
+/// SE(3) logarithm: `[V⁻¹(ω) t; ω]`, `V⁻¹ = I − ½ [ω]× + k [ω]×²`. mink forms `[ω]×²` as
+/// a matrix product; its terms with a zero factor (the skew matrix's diagonal) are left out
+/// here, which changes no value but the sign of a zero.
 #[must_use]
 pub fn se3_log(p: &Pose) -> Vector6<f64> {
     let omega = so3_log(&p.quat);
     let theta = omega.norm();
     let t2 = theta * theta;
     let skw = skew(&omega);
-    let skw2 = skw * skw;
+    let skw2 = mul3_sparse(&skw, &skw, |i, j, k| k == i || k == j);
     let coeff = if t2 < EPS {
         1.0 / 12.0
     } else {
         let half = 0.5 * theta;
         (1.0 - 0.5 * theta * half.cos() / half.sin()) / t2
     };
-    let mut vinv = skw * -0.5 + skw2 * coeff;
-    vinv[(0, 0)] += 1.0;
-    vinv[(1, 1)] += 1.0;
-    vinv[(2, 2)] += 1.0;
-    let v = vinv * p.pos;
+    let vinv = |i: usize, j: usize| {
+        if i == j {
+            skw2[(i, j)] * coeff + 1.0
+        } else {
+            skw[(i, j)] * -0.5 + skw2[(i, j)] * coeff
+        }
+    };
+    let t = &p.pos;
+    let v: [f64; 3] =
+        std::array::from_fn(|i| vinv(i, 0) * t[0] + vinv(i, 1) * t[1] + vinv(i, 2) * t[2]);
     Vector6::new(v[0], v[1], v[2], omega[0], omega[1], omega[2])
+}
+
+/// `a b` summed as nalgebra sums it (`Σₖ a[i, k] b[k, j]` from `k = 0`), without the terms
+/// where `zero(i, j, k)` says a factor is exactly zero (a skew matrix's diagonal): the same
+/// value up to the sign of a zero.
+#[inline(always)]
+fn mul3_sparse(
+    a: &Matrix3<f64>,
+    b: &Matrix3<f64>,
+    zero: impl Fn(usize, usize, usize) -> bool,
+) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| {
+        let mut sum: Option<f64> = None;
+        for k in (0..3).filter(|&k| !zero(i, j, k)) {
+            let term = a[(i, k)] * b[(k, j)];
+            sum = Some(sum.map_or(term, |s| s + term));
+        }
+        sum.unwrap_or(0.0)
+    })
 }
 
 /// `a ⊖ b = log(b⁻¹ · a)` (right minus).
@@ -189,13 +215,15 @@ fn q_block(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
     };
     let vs = skew(&v);
     let ws = skew(&w);
-    let vw = vs * ws;
+    // Products with a skew matrix, its zero diagonal's terms left out (`mul3_sparse`).
+    let right = |_: usize, j: usize, k: usize| k == j;
+    let vw = mul3_sparse(&vs, &ws, |i, j, k| k == i || k == j);
     let wv = vw.transpose();
-    let wvw = wv * ws;
-    let vww = vw * ws;
+    let wvw = mul3_sparse(&wv, &ws, right);
+    let vww = mul3_sparse(&vw, &ws, right);
     let vww_t = vww.transpose();
-    let wvww = wvw * ws;
-    let wwvw = ws * wvw;
+    let wvww = mul3_sparse(&wvw, &ws, right);
+    let wwvw = mul3_sparse(&ws, &wvw, |i, _, k| k == i);
     let mut q = Matrix3::zeros();
     for i in 0..9 {
         q[i] = a * vs[i] + b * (wv[i] + vw[i] + wvw[i]) - cc * (vww[i] - vww_t[i] - 3.0 * wvw[i])
@@ -261,6 +289,79 @@ mod tests {
 
     fn random_tangent(rng: &mut ChaCha8Rng, scale: f64) -> Vector6<f64> {
         Vector6::from_fn(|_, _| rng.gen_range(-1.0..1.0) * scale)
+    }
+
+    /// The mink-order implementations the sparse products replaced, for bitwise comparison.
+    /// SE(3) logarithm: `[V⁻¹(ω) t; ω]`.
+    fn se3_log_reference(p: &Pose) -> Vector6<f64> {
+        let omega = so3_log(&p.quat);
+        let theta = omega.norm();
+        let t2 = theta * theta;
+        let skw = skew(&omega);
+        let skw2 = skw * skw;
+        let coeff = if t2 < EPS {
+            1.0 / 12.0
+        } else {
+            let half = 0.5 * theta;
+            (1.0 - 0.5 * theta * half.cos() / half.sin()) / t2
+        };
+        let mut vinv = skw * -0.5 + skw2 * coeff;
+        vinv[(0, 0)] += 1.0;
+        vinv[(1, 1)] += 1.0;
+        vinv[(2, 2)] += 1.0;
+        let v = vinv * p.pos;
+        Vector6::new(v[0], v[1], v[2], omega[0], omega[1], omega[2])
+    }
+
+    fn q_block_reference(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
+        let v = Vector3::new(c[0], c[1], c[2]);
+        let w = Vector3::new(c[3], c[4], c[5]);
+        let t2 = theta * theta;
+        let a = 0.5;
+        let (b, cc, d) = if t2 < EPS {
+            (1.0 / 6.0 + (1.0 / 120.0) * t2, -(1.0 / 24.0) + (1.0 / 720.0) * t2, -(1.0 / 60.0))
+        } else {
+            let t4 = t2 * t2;
+            (
+                (theta - st) / (t2 * theta),
+                (1.0 - 0.5 * t2 - ct) / t4,
+                (2.0 * theta - 3.0 * st + theta * ct) / (2.0 * t4 * theta),
+            )
+        };
+        let vs = skew(&v);
+        let ws = skew(&w);
+        let vw = vs * ws;
+        let wv = vw.transpose();
+        let wvw = wv * ws;
+        let vww = vw * ws;
+        let vww_t = vww.transpose();
+        let wvww = wvw * ws;
+        let wwvw = ws * wvw;
+        let mut q = Matrix3::zeros();
+        for i in 0..9 {
+            q[i] = a * vs[i] + b * (wv[i] + vw[i] + wvw[i])
+                - cc * (vww[i] - vww_t[i] - 3.0 * wvw[i])
+                + d * (wvww[i] + wwvw[i]);
+        }
+        q
+    }
+
+    /// Bit for bit (zeros compared by value): `se3_log` and `q_block` as mink orders them.
+    #[test]
+    fn sparse_products_match_mink_order() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        for scale in [0.0, 1e-9, 1e-4, 0.3, 1.5, 3.0] {
+            for _ in 0..2000 {
+                let t = random_tangent(&mut rng, scale);
+                let p = se3_exp(&t);
+                let p =
+                    Pose { pos: p.pos + Vector3::from_fn(|_, _| rng.gen_range(-2.0..2.0)), ..p };
+                assert_eq!(se3_log(&p), se3_log_reference(&p));
+                let theta = Vector3::new(t[3], t[4], t[5]).norm();
+                let sc = theta.sin_cos();
+                assert_eq!(q_block(&t, theta, sc), q_block_reference(&t, theta, sc));
+            }
+        }
     }
 
     #[test]

@@ -157,6 +157,7 @@ impl<'m> Solver<'m> {
         if matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {
             self.take_step();
         }
+        self.place_geoms();
         Ok((self.relaxed_steps, optimal))
     }
 

@@ -54,13 +54,15 @@ pub struct BoxQp {
     chol: Vec<f64>,
     rhs: Vec<f64>,
     y: Vec<f64>,
-    /// Kinematic-tree sparsity of `h` (see [`BoxQp::set_tree`]) and its restriction to the
-    /// free variables.
-    parent: Option<Vec<Option<usize>>>,
-    /// Per variable, its ancestors nearest first (the chains of `parent`), for the all-free
-    /// factorisation.
+    /// The variables on a bound, ascending (for the right-hand sides of a face).
+    fixed: Vec<usize>,
+    /// Kinematic-tree sparsity of `h` (see [`BoxQp::set_tree`]): whether it is set, and per
+    /// variable its ancestors nearest first (the chains of `parent`).
+    tree: bool,
     chains: Vec<Vec<usize>>,
-    free_parent: Vec<Option<usize>>,
+    /// The same chains as runs of consecutive indices `lo..=hi`, nearest first: the
+    /// factorisation's updates run along them over contiguous memory.
+    chain_runs: Vec<Vec<(usize, usize)>>,
     /// Number of active-set iterations of the last solve.
     pub iterations: usize,
 }
@@ -80,9 +82,10 @@ impl BoxQp {
             chol: vec![0.0; n * n],
             rhs: vec![0.0; n],
             y: vec![0.0; n],
-            parent: None,
+            fixed: Vec::with_capacity(n),
+            tree: false,
             chains: Vec::new(),
-            free_parent: vec![None; n],
+            chain_runs: Vec::new(),
             iterations: 0,
         }
     }
@@ -102,7 +105,8 @@ impl BoxQp {
         } else {
             Vec::new()
         };
-        self.parent = ok.then_some(parent);
+        self.chain_runs = self.chains.iter().map(|chain| descending_runs(chain)).collect();
+        self.tree = ok;
     }
 
     /// Whether variable `i` ended on one of its bounds (in the working set).
@@ -217,156 +221,112 @@ impl BoxQp {
     /// Minimiser over the free variables with the others fixed at `x`, written to `rhs`
     /// (free entries only). `false` if the reduced Hessian is not positive definite.
     fn solve_face(&mut self) -> bool {
-        if self.parent.is_some() {
+        if self.tree {
             return self.solve_face_tree();
         }
         self.solve_face_dense()
     }
 
-    /// Right-hand side `−c_F − H_FW x_W` of free variable `i`.
+    /// Right-hand side `−c_F − H_FW x_W` of free variable `i` (`self.fixed`: the `W`).
     fn free_rhs(&self, i: usize) -> f64 {
-        let n = self.n;
-        let row = &self.h[i * n..(i + 1) * n];
+        let row = &self.h[i * self.n..(i + 1) * self.n];
         let mut r = -self.c[i];
-        for (j, (hij, xj)) in row.iter().zip(&self.x).enumerate() {
-            if self.state[j] != State::Free {
-                r -= hij * xj;
-            }
+        for &j in &self.fixed {
+            r -= row[j] * self.x[j];
         }
         r
     }
 
-    /// [`BoxQp::solve_face_tree`] with every variable free (the common case): the same
-    /// operations in the same order, over precomputed ancestor chains.
-    fn solve_all_free_tree(&mut self) -> bool {
+    /// `mj_factorI` / `mj_solveM` on the free variables, fixed ones cut out of the tree.
+    /// Every variable free is the common case.
+    fn solve_face_tree(&mut self) -> bool {
         let n = self.n;
         self.free.clear();
-        self.free.extend(0..n);
+        self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
+        self.fixed.clear();
+        self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
         self.chol.copy_from_slice(&self.h);
-        for (y, c) in self.y.iter_mut().zip(&self.c) {
-            *y = -c;
+        for i in 0..n {
+            self.y[i] = match (self.fixed.is_empty(), self.state[i]) {
+                (true, _) => -self.c[i],
+                (false, State::Free) => self.free_rhs(i),
+                _ => 0.0,
+            };
         }
+        if !self.factor_tree() {
+            return false;
+        }
+        self.solve_tree();
+        true
+    }
+
+    /// `L` and `D` of `H_FF = Lᵀ D L`, leaves first (`mj_factorI`), in place in `chol`.
+    /// Eliminating `k` subtracts `l_ki l_kj / d_k` from `(i, j)` for the free ancestors
+    /// `j ≤ i` of `k`: each entry once, so the updates run in any order, here along runs of
+    /// the chain. Entries in a fixed variable's column are updated too but never read for a
+    /// free one.
+    fn factor_tree(&mut self) -> bool {
+        let n = self.n;
         let l = &mut self.chol;
         for k in (0..n).rev() {
+            if self.state[k] != State::Free {
+                continue;
+            }
             let (above, rest) = l.split_at_mut(k * n);
             let row_k = &mut rest[..n];
             let dk = row_k[k];
             if dk.is_nan() || dk <= 0.0 || !dk.is_finite() {
                 return false;
             }
-            let chain = &self.chains[k];
-            for (a, &ii) in chain.iter().enumerate() {
-                let tmp = row_k[ii] / dk;
-                let row_ii = &mut above[ii * n..(ii + 1) * n];
-                for &jj in &chain[a..] {
-                    row_ii[jj] -= tmp * row_k[jj];
+            let runs = &self.chain_runs[k];
+            for (r, &(lo, hi)) in runs.iter().enumerate() {
+                for ii in (lo..=hi).rev().filter(|&i| self.state[i] == State::Free) {
+                    let tmp = row_k[ii] / dk;
+                    let row_ii = &mut above[ii * n..(ii + 1) * n];
+                    subtract_scaled(&mut row_ii[lo..=ii], tmp, &row_k[lo..=ii]);
+                    for &(lo, hi) in &runs[r + 1..] {
+                        subtract_scaled(&mut row_ii[lo..=hi], tmp, &row_k[lo..=hi]);
+                    }
+                    row_k[ii] = tmp;
                 }
-                row_k[ii] = tmp;
             }
-        }
-        let y = &mut self.y;
-        for k in (0..n).rev() {
-            let yk = y[k];
-            for &ii in &self.chains[k] {
-                y[ii] -= l[k * n + ii] * yk;
-            }
-        }
-        for k in 0..n {
-            y[k] /= l[k * n + k];
-        }
-        for k in 0..n {
-            let row_k = &l[k * n..(k + 1) * n];
-            let mut yk = y[k];
-            for &ii in &self.chains[k] {
-                yk -= row_k[ii] * y[ii];
-            }
-            y[k] = yk;
-            self.rhs[k] = yk;
         }
         true
     }
 
-    /// `mj_factorI` / `mj_solveM` on the free variables, fixed ones cut out of the tree.
-    fn solve_face_tree(&mut self) -> bool {
+    /// `L⁻¹`, `D⁻¹`, `L⁻ᵀ` on `y` (`mj_solveM`), the free entries into `rhs`. The fixed
+    /// entries of `y` take updates that no free one reads.
+    fn solve_tree(&mut self) {
         let n = self.n;
-        if self.state.iter().all(|s| *s == State::Free) && self.chains.len() == n {
-            return self.solve_all_free_tree();
-        }
-        let Some(parent) = self.parent.as_ref() else { return false };
-        self.free.clear();
-        self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
-        for d in 0..n {
-            let mut p = parent[d];
-            while let Some(q) = p {
-                if self.state[q] == State::Free {
-                    break;
-                }
-                p = parent[q];
-            }
-            self.free_parent[d] = p;
-        }
-        self.chol.copy_from_slice(&self.h);
-        let all_free = self.state.iter().all(|s| *s == State::Free);
-        for i in 0..n {
-            self.y[i] = match (all_free, self.state[i]) {
-                (true, _) => -self.c[i],
-                (false, State::Free) => self.free_rhs(i),
-                _ => 0.0,
-            };
-        }
-        let (l, fp) = (&mut self.chol, &self.free_parent);
-        for k in (0..n).rev() {
-            if self.state[k] != State::Free {
-                continue;
-            }
-            let dk = l[k * n + k];
-            if dk.is_nan() || dk <= 0.0 || !dk.is_finite() {
-                return false;
-            }
-            let mut i = fp[k];
-            while let Some(ii) = i {
-                let tmp = l[k * n + ii] / dk;
-                let mut j = Some(ii);
-                while let Some(jj) = j {
-                    l[ii * n + jj] -= tmp * l[k * n + jj];
-                    j = fp[jj];
-                }
-                l[k * n + ii] = tmp;
-                i = fp[ii];
+        let (l, y) = (&self.chol, &mut self.y);
+        for &k in self.free.iter().rev() {
+            let (yk, row_k) = (y[k], &l[k * n..(k + 1) * n]);
+            for &(lo, hi) in &self.chain_runs[k] {
+                subtract_scaled(&mut y[lo..=hi], yk, &row_k[lo..=hi]);
             }
         }
-        let y = &mut self.y;
-        for k in (0..n).rev() {
-            if self.state[k] == State::Free {
-                let mut i = fp[k];
-                while let Some(ii) = i {
-                    y[ii] -= l[k * n + ii] * y[k];
-                    i = fp[ii];
+        for &k in &self.free {
+            y[k] /= l[k * n + k];
+        }
+        for &k in &self.free {
+            let row_k = &l[k * n..(k + 1) * n];
+            let mut yk = y[k];
+            for &ii in &self.chains[k] {
+                if self.state[ii] == State::Free {
+                    yk -= row_k[ii] * y[ii];
                 }
             }
+            y[k] = yk;
+            self.rhs[k] = yk;
         }
-        for k in 0..n {
-            if self.state[k] == State::Free {
-                y[k] /= l[k * n + k];
-            }
-        }
-        for k in 0..n {
-            if self.state[k] == State::Free {
-                let mut i = fp[k];
-                while let Some(ii) = i {
-                    y[k] -= l[k * n + ii] * y[ii];
-                    i = fp[ii];
-                }
-                self.rhs[k] = y[k];
-            }
-        }
-        true
     }
 
     fn solve_face_dense(&mut self) -> bool {
         let n = self.n;
         self.free.clear();
         self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
+        self.fixed.clear();
+        self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
         let m = self.free.len();
         if m == n {
             self.chol.copy_from_slice(&self.h);
@@ -406,6 +366,26 @@ impl BoxQp {
         }
         true
     }
+}
+
+/// `x ← x − t y` elementwise.
+#[inline]
+fn subtract_scaled(x: &mut [f64], t: f64, y: &[f64]) {
+    for (x, y) in x.iter_mut().zip(y) {
+        *x -= t * y;
+    }
+}
+
+/// `chain` (strictly descending) as runs `(lo, hi)` of consecutive indices, in its order.
+fn descending_runs(chain: &[usize]) -> Vec<(usize, usize)> {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for &i in chain {
+        match runs.last_mut() {
+            Some(run) if run.0 == i + 1 => run.0 = i,
+            _ => runs.push((i, i)),
+        }
+    }
+    runs
 }
 
 /// Lower Cholesky factor `L` (row-major, lower triangle) of the `m × m` matrix in `a`.
