@@ -76,9 +76,9 @@ class Motion:
     def stages(self) -> Dict[str, Dict[str, Any]]:
         """What the default solve's stages said, ``{stage: {key: value}}`` in the order they
         ran (only stages with something to say), each with its one-line ``"summary"``:
-        ``"reweigh"`` (``pelvis_offset`` in m, ``share`` 0 to 1) and ``"uncross"``
-        (``stretches``: frames (first, last) of the human's crossed steps the robot could not
-        stand in, planned side by side and solved again)."""
+        ``"treadmill"`` (``belt_mps``, ``heading_rad``: the source's feet slid back on its
+        floor, an in-place loop, and it was walked forward) and ``"reweigh"``
+        (``pelvis_offset`` in m, ``share`` 0 to 1)."""
     @property
     def backward(self) -> Tuple[int, int]:
         """Frames taken from the backward first pass (``mode="both_ways"``; 0 otherwise)

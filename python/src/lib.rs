@@ -567,7 +567,7 @@ impl Motion {
     /// ``"summary"`` (as the main command prints it) and its values (numbers as float or int,
     /// frame stretches as lists of ``(first, last)``). ``"reweigh"``: ``pelvis_offset`` (m,
     /// the pelvis off its target with the config's weights) and ``share`` (0 to 1);
-    /// ``"uncross"``: ``stretches``, the crossed steps planned side by side and solved again.
+    /// ``"treadmill"``: ``belt_mps`` and ``heading_rad``, an in-place loop walked forward.
     #[getter]
     fn stages<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let out = PyDict::new(py);

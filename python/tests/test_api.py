@@ -105,19 +105,15 @@ def test_both_ways_takes_a_stuck_hip_from_the_backward_pass(shared):
     assert over["default"] > 100 and over["both_ways"] == 0, over
 
 
-def test_a_robot_that_cannot_stand_crossed_steps_beside(walk, tmp_path):
-    """Where the T1 cannot stand in one of the LAFAN1 walk's crouched crossovers (frames
-    2900–3400 of the walk, the subject height measured on them), that step is planned side by
-    side, as the main command says; the G1 stands in it."""
-    text = open(walk).read()
-    head, motion = text.split("MOTION", 1)
-    lines = [l for l in motion.splitlines() if l.strip()]
-    frame_time = next(l for l in lines if l.startswith("Frame Time"))
-    frames = lines[2:][2900:3400]
-    clip = tmp_path / "crossovers.bvh"
-    clip.write_text(f"{head}MOTION\nFrames: 500\n{frame_time}\n" + "\n".join(frames) + "\n")
-    motion = retarget.Retargeter("booster_t1_29dof").retarget_bvh(str(clip))
-    uncross = motion.stages["uncross"]
-    assert uncross["stretches"] == [(392, 400)], motion.stages
-    assert uncross["summary"].startswith("the robot could not stand in 1 crossed step"), uncross
-    assert "uncross" not in retarget.Retargeter("unitree_g1").retarget_bvh(str(clip)).stages
+def test_an_in_place_loop_is_walked_forward_and_says_so(shared, walk):
+    """The XNA dude's FBX walk cycle slides its feet back along its floor (an in-place loop):
+    the default solve walks it forward at that speed and its ``treadmill`` stage says so; the
+    LAFAN1 walk, on a floor that stays put, has no such stage."""
+    fbx = shared / "data/fbx/xna_dude_walk_fbxsdk2017.fbx"
+    motion = retarget.Retargeter("unitree_g1").retarget_fbx(str(fbx))
+    belt = motion.stages["treadmill"]
+    assert 0.8 < belt["belt_mps"] < 1.2, belt
+    assert belt["summary"].startswith("the source's feet slide back"), belt
+    travel = np.linalg.norm(motion.qpos[-1, :2] - motion.qpos[0, :2])
+    assert travel > 0.8, travel
+    assert "treadmill" not in retarget.Retargeter("unitree_g1").retarget_bvh(str(walk)).stages

@@ -176,37 +176,6 @@ fn both_ways_reports_what_it_took_from_the_backward_pass() {
     assert!(stderr(&out).contains("cannot be used with"), "{}", stderr(&out));
 }
 
-/// The main command says where the robot could not stand in the human's crossed steps
-/// (the T1 in the LAFAN1 walk's crouched crossovers, frames 2900–3400 of the walk), and the
-/// same with `--chunk-frames`.
-#[test]
-fn the_main_command_says_which_crossed_steps_it_uncrossed() {
-    let text = std::fs::read_to_string(repo("data/samples/lafan1_walk.bvh")).unwrap();
-    let (head, motion) = text.split_once("MOTION").unwrap();
-    let mut lines = motion.lines().filter(|l| !l.trim().is_empty()).skip(2);
-    let frame_time = motion.lines().find(|l| l.starts_with("Frame Time")).unwrap();
-    let frames: Vec<&str> = lines.by_ref().skip(2900).take(500).collect();
-    let dir = temp_dir("uncrossed");
-    let walk = dir.join("crossovers.bvh");
-    let slice = format!("{head}MOTION\nFrames: 500\n{frame_time}\n{}\n", frames.join("\n"));
-    std::fs::write(&walk, slice).unwrap();
-    let out_path = dir.join("walk.npz");
-    let args = ["--bvh", walk.to_str().unwrap(), "--robot", "booster_t1_29dof", "-o"];
-    for extra in [&[][..], &["--chunk-frames", "200"][..]] {
-        let out = retarget(&[&args[..], &[out_path.to_str().unwrap()], extra].concat());
-        assert!(out.status.success(), "{}", stderr(&out));
-        let text = stdout(&out);
-        assert!(
-            text.lines().any(|l| l.starts_with(
-                "default solve: the robot could not stand in 1 \
-                 crossed step of the human's (frames 392-400); planned uncrossed and solved \
-                 again"
-            )),
-            "{text}"
-        );
-    }
-}
-
 #[test]
 fn main_command_and_batch_take_the_same_options() {
     let main = help_entries(&stdout(&retarget(&["--help"])));

@@ -421,33 +421,23 @@ fn a_limb_stuck_in_another_branch_is_taken_from_the_backward_pass() {
 }
 
 /// The LAFAN1 walk crosses over in a crouch (near frames 2990 and 3292 of the shared take, the
-/// right foot landing 11 cm to the left of the left one). The T1's legs are too thick to stand
-/// like that: held crossed, its planted feet came off their targets and its pelvis sank 9–12
-/// cm below its target, lifted by legs in each other's way. Planned again uncrossed
-/// ([`retarget::PlausibleOptions::uncross_stuck`]), they stay.
+/// right foot landing 11 cm to the left of the left one). The T1's legs are thick for it: the
+/// per-frame solve, held crossed, lifted its planted feet off their targets and sank its
+/// pelvis 9–12 cm below its target. The trajectory solve stands in them. (An uncrossing stage
+/// planned such steps side by side; on the corpus it changed one row of 250, by 0.14 points
+/// of floor skating, and was deleted: decision 017.)
 #[test]
-fn a_robot_that_cannot_stand_crossed_steps_beside_instead() {
+fn a_robot_with_thick_legs_stands_in_crossed_steps() {
     let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
         return;
     };
     let (full, fk_report) =
         fk::human_motion(&bvh::from_path(&path).unwrap(), &fk::FkOptions::default()).unwrap();
     let human = slice(&full, 2900..3400);
-    let robot = |uncross_stuck| {
-        let mode = retarget::SolveMode::Plausible({
-            let mut o = retarget::PlausibleOptions::default();
-            o.uncross_stuck = uncross_stuck;
-            o
-        });
-        retarget::Retargeter::new("booster_t1_29dof")
-            .unwrap()
-            .with_mode(mode)
-            .with_human_height(Some(fk_report.height))
-    };
-    let (solved, diag) = robot(true).retarget(&human).unwrap();
-    let (held_crossed, held) = robot(false).retarget(&human).unwrap();
-    assert!(held.stages.iter().all(|r| r.stage != "uncross"), "{:?}", held.stages);
-    let r = robot(true);
+    let r = retarget::Retargeter::new("booster_t1_29dof")
+        .unwrap()
+        .with_human_height(Some(fk_report.height));
+    let (solved, diag) = r.retarget(&human).unwrap();
     let model = r.model();
     // Over the crossovers (both feet down, the right foot 11 cm left of the left one, frames
     // 90–96 and 392–400 of the slice): how far the pelvis sinks below its target, and the
@@ -470,15 +460,12 @@ fn a_robot_that_cannot_stand_crossed_steps_beside_instead() {
         }
         (sink, foot)
     };
-    // The per-frame solve this replaced sank the pelvis 11 cm there held crossed and kept a
-    // planted foot 3.3 cm off; the trajectory solve stands in them (the uncrossing, which
-    // plans such steps side by side where the robot is stuck, finds nothing to do).
-    for (what, motion, frames) in [("default", &solved, &diag), ("held", &held_crossed, &held)] {
-        let (sink, foot) = worst(motion, frames);
-        eprintln!("{what}: stages {:?}, sink {sink:.3} m, foot {foot:.3} m", frames.stages);
-        assert!(sink < 0.03, "{what}: the pelvis sinks {sink} m");
-        assert!(foot < 0.06, "{what}: a planted foot {foot} m off");
-    }
+    // The per-frame solve this replaced sank the pelvis 11 cm there and kept a planted foot
+    // 3.3 cm off.
+    let (sink, foot) = worst(&solved, &diag);
+    eprintln!("stages {:?}, sink {sink:.3} m, foot {foot:.3} m", diag.stages);
+    assert!(sink < 0.03, "the pelvis sinks {sink} m");
+    assert!(foot < 0.06, "a planted foot {foot} m off");
 }
 
 /// `bvh` sampled `factor` times as often: Catmull–Rom through every channel, angles unwrapped

@@ -39,9 +39,8 @@
 //!    flattened to stand on its whole sole could not, stood on its toe corners as its knee
 //!    allowed and slid them: floor skating 9.9 → 6.4 %, over the ten robots 5.6–23.4 →
 //!    0.6–16.5 %.)
-//!    Overlapping stance phases of the two feet are kept apart; where the left foot stands
-//!    to the right of the right one, they are a [`Crossing`], which the solve can ask to be
-//!    planned again side by side ([`plan_uncrossing`]) when the robot cannot stand in it.
+//!    Overlapping stance phases of the two feet are kept apart; crossed ones (the left foot
+//!    to the right of the right one) stay crossed: the trajectory solve stands in them.
 //! 3. **Swing**: out of stance the sole stays at least [`FootPlanOptions::swing_clearance`]
 //!    above the floor ([`FootPlan::swing_floor`], which the solve holds as that sole's
 //!    floor), risen to it over [`FootPlanOptions::lift_s`] after lift-off and left over as
@@ -56,9 +55,8 @@
 //! One file per concept: `detect.rs` which bodies are the feet ([`detect_feet`]), `soles.rs`
 //! the robot foot and its sole ([`RobotFoot`], [`SolePoint`]: every collision primitive on the
 //! foot body and its descendants; `inertia.rs` the sole of a foot without collision geometry),
-//! `floor.rs` step 1, `anchors.rs` and `stance.rs` step 2, `swing.rs` step 3, `crossings.rs`
-//! crossed stances ([`Crossing`]), `plan_options.rs` the tunables ([`FootPlanOptions`]); this
-//! file holds the plan, in order.
+//! `floor.rs` step 1, `anchors.rs` and `stance.rs` step 2, `swing.rs` step 3, `plan_options.rs`
+//! the tunables ([`FootPlanOptions`]); this file holds the plan, in order.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact
@@ -66,7 +64,6 @@
 #![allow(clippy::indexing_slicing)]
 
 mod anchors;
-mod crossings;
 mod detect;
 mod floor;
 mod inertia;
@@ -79,13 +76,11 @@ mod swing;
 use crate::lie::Pose;
 use crate::motion::FootContacts;
 use anchors::{foot_anchors, separate, Planted};
-use crossings::uncrossed;
 use floor::{floor_shift, keep_feet_apart};
 use math::quat;
 use stance::{plant, roll_shares, Stand};
 use swing::{swing, Swing};
 
-pub use crossings::{Crossing, Uncrossing};
 pub use detect::detect_feet;
 pub(crate) use inertia::inertia_sole;
 pub(crate) use math::wrap;
@@ -105,13 +100,9 @@ pub struct FootPlan {
     /// Per frame and foot out of stance: the least height (m) above the floor the swing
     /// clearance asks of the sole's lowest point, where it asks any.
     pub swing_floor: Vec<[Option<f64>; 2]>,
-    /// Stance phases of the two feet that overlap in time with the left foot planted to the
-    /// right of the right one ([`Crossing`]), as planned (uncrossed ones included).
-    pub crossed: Vec<Crossing>,
 }
 
 /// Rewrites `targets` (`frames × slots` poses, frame-major) in place; see the module docs.
-#[cfg(test)]
 pub fn plan(
     feet: &[Option<RobotFoot>; 2],
     contacts: &FootContacts,
@@ -120,23 +111,6 @@ pub fn plan(
     fps: f64,
     options: &FootPlanOptions,
 ) -> FootPlan {
-    plan_uncrossing(feet, contacts, targets, slots, fps, options, &Uncrossing::default())
-}
-
-/// `plan`, with the crossed stance phases `crossings.uncross` moved apart sideways until
-/// they are no longer crossed and their soles are [`FootPlanOptions::sole_gap`] apart, half
-/// the way each. Crossed and apart are across the robot's heading
-/// ([`Uncrossing::heading`]).
-pub fn plan_uncrossing(
-    feet: &[Option<RobotFoot>; 2],
-    contacts: &FootContacts,
-    targets: &mut [Pose],
-    slots: usize,
-    fps: f64,
-    options: &FootPlanOptions,
-    crossings: &Uncrossing<'_>,
-) -> FootPlan {
-    let Uncrossing { uncross, heading } = *crossings;
     let frames = targets.len().checked_div(slots).unwrap_or(0);
     let labels = [&contacts.left, &contacts.right];
     // 1. The floor.
@@ -152,7 +126,6 @@ pub fn plan_uncrossing(
         weight: vec![[1.0; 2]; frames],
         contact: vec![[Vec::new(), Vec::new()]; frames],
         swing_floor: vec![[None; 2]; frames],
-        crossed: Vec::new(),
     };
     // 2. Planting: each foot's stance phases and their anchors, kept apart, then the
     // planted poses; 3. the swing.
@@ -161,7 +134,6 @@ pub fn plan_uncrossing(
         free_feet(feet, &labels, targets, slots, lead, options);
     if let [Some(left), Some(right)] = feet {
         separate(left, right, &mut anchors, options.sole_gap);
-        plan.crossed = uncrossed(left, right, &mut anchors, options.sole_gap, uncross, heading);
     }
     let planted_mask = anchors.each_ref().map(|phases| planted_frames(phases, frames));
     let roll_frames = (options.roll_s * fps).round().max(1.0);

@@ -32,18 +32,13 @@ impl<'a> Prepared<'a> {
     /// constraints apply).
     pub(super) fn plan_feet(&mut self, options: &PlausibleOptions, feet: [Option<RobotFoot>; 2]) {
         let Some(contacts) = &self.contacts else { return };
-        if options.uncross_stuck {
-            self.unplanned = Some(self.targets.clone());
-        }
-        let heading = self.heading();
-        let plan = crate::feet::plan_uncrossing(
+        let plan = crate::feet::plan(
             &feet,
             contacts,
             &mut self.targets,
             self.slots,
             self.fps,
             &options.feet,
-            &crate::feet::Uncrossing { uncross: &[], heading: &heading },
         );
         self.plan = Some((feet, plan));
     }

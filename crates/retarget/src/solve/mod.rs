@@ -10,12 +10,11 @@
 //! | 4 | reweighing | `reweigh.rs` | trunk and leg weights where the config's pelvis disagrees with the robot's legs | [`PlausibleOptions`] |
 //! | 5 | first pass | `first_pass.rs` | every frame solved causally with the hard constraints (what streams run) | [`crate::SolverOptions`] |
 //! | 6 | trajectory | `trajectory.rs`, `windows.rs`, `banded.rs`, `dynamics_term.rs` | every frame of a window at once: tracking, smooth accelerations of every coordinate, the wrench the feet cannot supply, every constraint | [`TrajectoryOptions`], [`DynamicsOptions`] |
-//! | 7 | uncrossing | `uncross.rs` | crossed stances the robot could not stand in, planned side by side and solved again | [`PlausibleOptions::uncross_stuck`] |
 //!
 //! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
 //! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
 //! 2 and 5 with GMR's solver and nothing else. A stage with something to say about the clip
-//! pushes a [`StageReport`] (named after its file: `treadmill`, `reweigh`, `uncross`) onto
+//! pushes a [`StageReport`] (named after its file: `treadmill`, `reweigh`) onto
 //! [`ClipDiagnostics::stages`].
 
 pub(crate) mod banded;
@@ -29,7 +28,6 @@ mod reweigh;
 mod schedule;
 pub mod trajectory;
 mod treadmill;
-mod uncross;
 mod windows;
 
 use std::ops::Range;
@@ -106,12 +104,10 @@ pub fn retarget_motion(
     let start = Instant::now();
     // 5 and 6. The first pass and the trajectory solve, over the schedule.
     let n = prepared.num_frames();
-    let mut solved = match options.chunk {
+    let solved = match options.chunk {
         None => solve_range(&prepared, 0..n, 0)?,
         Some(chunk) => schedule::solve_chunks(&prepared, chunk)?,
     };
-    // 7. Uncrossing.
-    prepared.resolve_uncrossed(&mut solved)?;
     Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
 }
 

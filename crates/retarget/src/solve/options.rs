@@ -73,19 +73,6 @@ pub struct PlausibleOptions {
     /// the kick, and the backward pass, which reaches the kick from the normal stance, never
     /// does. Costs a second first pass, run on a second thread of rayon's pool.
     pub both_ways: bool,
-    /// Where the robot could not stand in a crossed stance (`Crossing`: in a
-    /// frame both feet are down, a planted foot `UNCROSS_STUCK` or further from its target,
-    /// the legs within `LEGS_TOUCH` of each other and the pelvis `UNCROSS_SINK` or more
-    /// below its target), plan those steps again side by side and solve their frames again.
-    /// The human crosses over in a crouch on the LAFAN1 walk (near frames 2990, 3240 and 3300,
-    /// the right foot landing 11 cm to the left of the left one); the T1's legs are too thick
-    /// for it: held crossed, its self-collision rows lifted its planted feet up to 10 cm and
-    /// sank its pelvis up to 19 cm below its target. Uncrossing every crossed stance instead
-    /// kept the T1's feet down but tripled the foot error of every robot (the G1's walk 14 →
-    /// 49 mm), whose legs cross there without trouble. Costs solving again the frames whose
-    /// targets that changed (`Prepared::resolve_uncrossed`; the T1's LAFAN1 walk: 2 steps,
-    /// 504 frames of 7,184 with the margins and lead-in; 5 % more time).
-    pub uncross_stuck: bool,
     /// The trajectory solve over every frame ([`crate::TrajectoryOptions`]); 0 iterations:
     /// the first pass alone.
     pub trajectory: crate::solve::trajectory::TrajectoryOptions,
@@ -129,7 +116,6 @@ impl Default for PlausibleOptions {
             root_position_weight_cap: 20.0,
             pelvis_offset_range: [0.005, 0.015],
             both_ways: false,
-            uncross_stuck: true,
             trajectory: crate::solve::trajectory::TrajectoryOptions::default(),
             max_extra_steps: 10,
         }
@@ -146,7 +132,6 @@ impl PlausibleOptions {
         PlausibleOptions {
             planting: Planting::Off,
             both_ways: false,
-            uncross_stuck: false,
             trajectory: crate::solve::trajectory::TrajectoryOptions {
                 iterations: 0,
                 ..Default::default()
@@ -207,8 +192,8 @@ pub struct ClipDiagnostics {
     /// Wall time of the IK alone (seconds).
     pub solve_seconds: f64,
     /// What the default solve's stages say about the clip ([`StageReport`]), in the order
-    /// they ran; only stages that have something to say (the reweighing where the config's
-    /// pelvis disagrees with the robot's legs, the uncrossing where it solved steps again).
+    /// they ran; only stages that have something to say (the treadmill where the source walks
+    /// in place, the reweighing where the config's pelvis disagrees with the robot's legs).
     pub stages: Vec<StageReport>,
 }
 
@@ -218,11 +203,11 @@ pub struct ClipDiagnostics {
 /// summary under `"summary"`.
 ///
 /// A stage that reports pushes one of these onto the solve's reports in its own file
-/// (`Prepared::reports`, as `solve/reweigh.rs` and `solve/uncross.rs` do); the CLI, Python
+/// (`Prepared::reports`, as `solve/treadmill.rs` and `solve/reweigh.rs` do); the CLI, Python
 /// and [`ClipDiagnostics`] collect them without knowing the stage.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct StageReport {
-    /// The stage's name: its file in `solve/` without `.rs` (`"reweigh"`, `"uncross"`).
+    /// The stage's name: its file in `solve/` without `.rs` (`"treadmill"`, `"reweigh"`).
     pub stage: &'static str,
     /// One line, no trailing newline (e.g. `the pelvis stands 1.3 cm off its target with the
     /// config's weights; trunk and leg weights reweighed 87 %`).

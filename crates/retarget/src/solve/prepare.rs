@@ -39,9 +39,6 @@ pub(crate) struct Prepared<'a> {
     pub(super) contacts: Option<FootContacts>,
     /// Foot bodies and per-frame weight factors (default mode).
     pub(super) plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
-    /// The targets before the foot plan rewrote them (default mode, planted feet), to plan
-    /// again from ([`Prepared::uncross_stuck`]).
-    pub(super) unplanned: Option<Vec<Pose>>,
     pub(super) fps: f64,
     pub(super) height: f64,
     /// Target slot of the human root.
@@ -95,7 +92,6 @@ impl<'a> Prepared<'a> {
             targets,
             contacts: None,
             plan: None,
-            unplanned: None,
             fps: human.fps,
             height,
             root_target: map.root,
@@ -107,26 +103,6 @@ impl<'a> Prepared<'a> {
     /// The robot body a task follows the human root's target with.
     pub(super) fn root_body(&self) -> Option<usize> {
         self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
-    }
-
-    /// Per frame, the yaw (rad) the robot's pelvis is to face: the root target's turn of the
-    /// body's forward direction (world +x at `qpos0`, as for the feet). Empty when no task
-    /// follows the root target.
-    pub(super) fn heading(&self) -> Vec<f64> {
-        let Some(body) = self.root_body() else { return Vec::new() };
-        let mut data = mjcf::Data::new(self.model);
-        self.model.kinematics(&self.model.qpos0, &mut data);
-        let forward = data.xquat[body].inverse() * Vector3::x();
-        (0..self.num_frames())
-            .map(|t| {
-                let p = &self.frame_targets(t)[self.root_target];
-                let q = UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
-                    p.quat[0], p.quat[1], p.quat[2], p.quat[3],
-                ));
-                let f = q * forward;
-                f.y.atan2(f.x)
-            })
-            .collect()
     }
 
     pub(super) fn contact_weight(&self) -> f64 {
