@@ -1,4 +1,4 @@
-//! A whole array in memory, as read by [`crate::Npz::array`] and written by [`crate::write`].
+//! A whole array in memory, as read by [`crate::Npz::array`] and written by [`crate::write()`].
 
 /// Array contents.
 #[derive(Debug, Clone, PartialEq)]

@@ -8,7 +8,7 @@
 //! byte order, C or Fortran order (returned in C order). Pickled object arrays are an error,
 //! never unpickled.
 //!
-//! Writing ([`write`], [`Array::to_npy`]) is numpy's own layout: `numpy.savez`'s stored
+//! Writing ([`write()`], [`Array::to_npy`]) is numpy's own layout: `numpy.savez`'s stored
 //! members, `numpy.save`'s header padded so the data starts 64-byte aligned, float64 (`<f8`),
 //! bool (`|b1`) and unicode (`<U`n) arrays.
 //!

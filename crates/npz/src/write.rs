@@ -1,4 +1,4 @@
-//! Writing an `.npz` ([`write`]).
+//! Writing an `.npz` ([`write()`]).
 
 use std::io::{Seek, Write};
 
