@@ -120,9 +120,9 @@ pub fn write_motion(
     }
 }
 
-/// Writes `arrays` (name, array, in file order) as an `.npz` in numpy's `savez_compressed`
-/// layout, atomically ([`write_atomically`]): for arrays other than a robot motion's (the
-/// CLI's export of a human motion).
+/// Writes `arrays` (name, array, in file order) as an `.npz` in numpy's `savez` layout
+/// ([`::npz::write()`]), atomically ([`write_atomically`]): for arrays other than a robot
+/// motion's (the CLI's export of a human motion).
 pub fn write_npz(path: &Path, arrays: &[(&str, ::npz::Array)]) -> Result<(), Error> {
     write_atomically(path, |w| ::npz::write(w, arrays))
 }
