@@ -17,7 +17,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyTypeError, PyValueError
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyMapping};
 
-use retarget::writers::npy::{Array, ArrayData};
+use npz::{Array, ArrayData};
 use retarget::writers::Format;
 use retarget::{ClipDiagnostics, HumanFrame, RetargetOptions, RobotMotion, StageValue};
 

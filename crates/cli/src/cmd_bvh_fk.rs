@@ -90,7 +90,7 @@ pub fn run(args: &FkArgs) -> anyhow::Result<ExitCode> {
 
 /// The whole clip's FK and roles as an `.npz` (see [`FkArgs::npz`]).
 pub fn write_npz(bvh: &bvh::Bvh, options: &FkOptions, out: &Path) -> anyhow::Result<()> {
-    use retarget::writers::npy::Array;
+    use npz::Array;
     let (motion, report) = fk::human_motion(bvh, options)?;
     let (t, b) = (motion.num_frames, motion.body_names.len());
     let mut pos = Vec::with_capacity(t * b * 3);
@@ -317,23 +317,15 @@ Frame Time: 0.033333
     /// `--npz`: every frame's poses, as `frame_poses` gives them one frame at a time.
     #[test]
     fn npz_holds_every_frame() {
-        use retarget::writers::npy::{decode, ArrayData};
-        use std::io::Read as _;
         let bvh = bvh::from_str(TINY).unwrap();
         let path = std::env::temp_dir().join(format!("fk-npz-{}.npz", std::process::id()));
         write_npz(&bvh, &FkOptions::default(), &path).unwrap();
-        let mut zip = zip::ZipArchive::new(std::fs::File::open(&path).unwrap()).unwrap();
-        let mut array = |name: &str| {
-            let mut bytes = Vec::new();
-            zip.by_name(&format!("{name}.npy")).unwrap().read_to_end(&mut bytes).unwrap();
-            decode(&bytes).unwrap()
-        };
-        let pos = array("body_pos_w");
-        assert_eq!(pos.shape, [2, 6, 3]);
-        assert_eq!(array("body_quat_w").shape, [2, 6, 4]);
+        let mut npz = npz::Npz::open(&path).unwrap();
+        let (shape, pos) = npz.floats("body_pos_w").unwrap();
+        assert_eq!(shape, [2, 6, 3]);
+        assert_eq!(npz.header("body_quat_w").unwrap().shape, [2, 6, 4]);
         // Not a humanoid (no arms): no roles, but the arrays are there.
-        assert_eq!(array("role_frame_offsets").shape, [0, 4]);
-        let ArrayData::F64(pos) = pos.data else { panic!("float64 expected") };
+        assert_eq!(npz.header("role_frame_offsets").unwrap().shape, [0, 4]);
         let poses = frame_poses(&bvh, 1, &FkOptions::default()).unwrap();
         for (b, body) in poses.bodies.iter().enumerate() {
             let at = &pos[(6 + b) * 3..(6 + b) * 3 + 3];

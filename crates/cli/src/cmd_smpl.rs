@@ -104,7 +104,7 @@ fn info(file: &Path, args: &ModelArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn fk(file: &Path, out: &Path, args: &ModelArgs) -> anyhow::Result<ExitCode> {
-    use retarget::writers::npy::Array;
+    use npz::Array;
     let motion = read(file)?;
     let model = args.models().for_motion(&motion, args.gender)?;
     let clip = smpl::clip(&model, &motion).with_context(|| file.display().to_string())?;

@@ -177,7 +177,8 @@ fn a_crafted_npz_is_an_error_not_an_abort() {
     assert_eq!(
         stderr.trim(),
         format!(
-            "error: {}: joint_names: dtype <U0 with 100000000000000 elements in 0 bytes of data",
+            "error: {}: array `joint_names`: dtype <U0 with 100000000000000 elements in 0 bytes \
+             of data",
             path.display()
         )
     );

@@ -8,7 +8,8 @@ mod shared;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use retarget::writers::{self, npy::Array};
+use npz::Array;
+use retarget::writers;
 use retarget::RobotMotion;
 
 fn retarget(args: &[&str]) -> Output {

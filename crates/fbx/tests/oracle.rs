@@ -8,8 +8,6 @@
 //! evaluation. `cargo test -p fbx --release --test oracle -- --nocapture` prints the
 //! measured numbers.
 
-#[path = "support/npz.rs"]
-mod npz;
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
@@ -38,31 +36,32 @@ struct Oracle {
 
 impl Oracle {
     fn load(shared: &std::path::Path, stem: &str) -> Oracle {
-        let d = npz::read(&shared.join(format!("reference/fbx_oracle/{stem}.npz")));
-        let names = d["bone_names"].strings().to_vec();
-        let mirrored = d["bone_negative_scale"].bools().to_vec();
+        let path = shared.join(format!("reference/fbx_oracle/{stem}.npz"));
+        let d = npz::Npz::open(&path).unwrap().arrays().unwrap();
+        let names = d["bone_names"].as_strings().unwrap().to_vec();
+        let mirrored = d["bone_negative_scale"].as_bools().unwrap().to_vec();
         Oracle { names, mirrored, d }
     }
     fn takes(&self) -> Vec<String> {
-        self.d["take_names"].strings().to_vec()
+        self.d["take_names"].as_strings().unwrap().to_vec()
     }
     fn times(&self, k: usize) -> &[f64] {
-        self.d[&format!("times_{k}")].f64()
+        self.d[&format!("times_{k}")].as_f64().unwrap()
     }
     fn exact(&self, k: usize, t: usize) -> bool {
-        self.d[&format!("exact_{k}")].bools()[t]
+        self.d[&format!("exact_{k}")].as_bools().unwrap()[t]
     }
     fn in_stack(&self, k: usize, t: usize) -> bool {
-        self.d[&format!("in_stack_{k}")].bools()[t]
+        self.d[&format!("in_stack_{k}")].as_bools().unwrap()[t]
     }
     fn position(&self, k: usize, t: usize, j: usize) -> Vector3<f64> {
         let b = self.names.len();
-        let p = &self.d[&format!("positions_{k}")].f64()[(t * b + j) * 3..];
+        let p = &self.d[&format!("positions_{k}")].as_f64().unwrap()[(t * b + j) * 3..];
         Vector3::new(p[0], p[1], p[2])
     }
     fn quat(&self, k: usize, t: usize, j: usize) -> UnitQuaternion<f64> {
         let b = self.names.len();
-        let q = &self.d[&format!("quats_{k}")].f64()[(t * b + j) * 4..];
+        let q = &self.d[&format!("quats_{k}")].as_f64().unwrap()[(t * b + j) * 4..];
         UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]))
     }
 }

@@ -9,6 +9,7 @@ use std::io::Cursor;
 use std::sync::OnceLock;
 
 use arbitrary::{Arbitrary, Result, Unstructured};
+use npz::{Array, ArrayData};
 
 use crate::seeds::files;
 use crate::Target;
@@ -909,8 +910,11 @@ struct NpzTarget;
 
 impl NpzTarget {
     fn npy(m: &NpyMember) -> Vec<u8> {
-        const DESCR: &[&str] =
-            &["<f8", "<f4", "<i8", "<i4", "|b1", "<U0", "<U1", "<U12", "<u2", ">f8", "<U"];
+        #[rustfmt::skip]
+        const DESCR: &[&str] = &[
+            "<f8", "<f4", "<i8", "<i4", "|b1", "<U0", "<U1", "<U12", "<u2", ">f8", "<U", "<f2",
+            ">i2", "|u1", "<u8", "|S4", "|S0", ">U3", "|O", "<c16",
+        ];
         let mut shape: Vec<String> = m.shape.iter().take(4).map(|d| (d % 64).to_string()).collect();
         if let Some((at, big)) = m.huge {
             let i = usize::from(at) % shape.len().max(1);
@@ -959,72 +963,35 @@ impl NpzTarget {
         zip.finish().map(Cursor::into_inner).unwrap_or_default()
     }
 
-    /// The members of a motion of the G1 (so that the report runs), numbers arbitrary.
+    /// The members of a motion of the G1 (so that the report runs), numbers arbitrary,
+    /// written by the `npz` crate's writer.
     fn coherent(u: &mut Unstructured<'_>) -> Result<Vec<(String, Vec<u8>, bool)>> {
         let model = g1();
         let wild = u.ratio(1, 4)?;
         let frames = u.int_in_range(1..=6)?;
-        let floats = |u: &mut Unstructured<'_>, n: usize, base: &[f64]| -> Result<Vec<u8>> {
-            let mut out = Vec::with_capacity(8 * n);
+        let floats = |u: &mut Unstructured<'_>, shape: Vec<usize>, base: &[f64]| -> Result<Array> {
+            let n = shape.iter().product();
+            let mut out = Vec::with_capacity(n);
             for k in 0..n {
                 let b = base.get(k % base.len().max(1)).copied().unwrap_or(0.0);
-                let v = match Num::arbitrary(u)? {
+                out.push(match Num::arbitrary(u)? {
                     Num::Tenths(t) => b + f64::from(t) * 1e-3,
                     Num::Small(t) => b + f64::from(t) * 1e-2,
                     other if wild => num_value(other),
                     _ => b,
-                };
-                out.extend_from_slice(&v.to_le_bytes());
+                });
             }
-            Ok(out)
+            Ok(Array::f64(shape, out))
         };
-        let width =
-            |names: &[String]| names.iter().map(|s| s.chars().count()).max().unwrap_or(1).max(1);
-        let strings = |names: &[String]| -> Vec<u8> {
-            let w = width(names);
-            let mut out = Vec::new();
-            for n in names {
-                let mut count = 0;
-                for c in n.chars() {
-                    out.extend_from_slice(&u32::from(c).to_le_bytes());
-                    count += 1;
-                }
-                out.resize(out.len() + 4 * (w - count), 0);
-            }
-            out
-        };
-        let member = |key: &str, descr: String, shape: &str, data: Vec<u8>| {
-            let header =
-                format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}\n");
-            let mut out = b"\x93NUMPY\x01\x00".to_vec();
-            out.extend_from_slice(&u16::try_from(header.len()).unwrap_or(0).to_le_bytes());
-            out.extend_from_slice(header.as_bytes());
-            out.extend_from_slice(&data);
-            (format!("{key}.npy"), out, false)
-        };
+        let member = |key: &str, array: Array| (format!("{key}.npy"), array.to_npy(), false);
         let joints = retarget::RobotMotion::model_joint_names(model);
         let bodies = retarget::RobotMotion::model_body_names(model);
         let nq = model.nq;
         let mut members = vec![
-            member("fps", "<f8".to_owned(), "(1,)", floats(u, 1, &[30.0])?),
-            member(
-                "qpos",
-                "<f8".to_owned(),
-                &format!("({frames}, {nq})"),
-                floats(u, frames * nq, &model.qpos0)?,
-            ),
-            member(
-                "joint_names",
-                format!("<U{}", width(&joints)),
-                &format!("({},)", joints.len()),
-                strings(&joints),
-            ),
-            member(
-                "body_names",
-                format!("<U{}", width(&bodies)),
-                &format!("({},)", bodies.len()),
-                strings(&bodies),
-            ),
+            member("fps", floats(u, vec![1], &[30.0])?),
+            member("qpos", floats(u, vec![frames, nq], &model.qpos0)?),
+            member("joint_names", Array::strings(&joints)),
+            member("body_names", Array::strings(&bodies)),
         ];
         // Other tools' layouts (`read_motion`): qpos without names, or BeyondMimic's keys.
         match u.int_in_range(0..=3)? {
@@ -1037,66 +1004,26 @@ impl NpzTarget {
                         && (keep_names || n != "joint_names.npy")
                 });
                 let b = u.int_in_range(1..=4)?;
-                let joints = nq - 7;
                 let base = model.qpos0.get(7..).unwrap_or_default();
-                let shape = |dims: &[usize]| {
-                    format!(
-                        "({})",
-                        dims.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
-                    )
-                };
-                members.push(member(
-                    "joint_pos",
-                    "<f8".to_owned(),
-                    &shape(&[frames, joints]),
-                    floats(u, frames * joints, base)?,
-                ));
-                members.push(member(
-                    "body_pos_w",
-                    "<f8".to_owned(),
-                    &shape(&[frames, b, 3]),
-                    floats(u, frames * b * 3, &[0.0, 0.0, 0.79])?,
-                ));
-                members.push(member(
-                    "body_quat_w",
-                    "<f8".to_owned(),
-                    &shape(&[frames, b, 4]),
-                    floats(u, frames * b * 4, &[1.0, 0.0, 0.0, 0.0])?,
-                ));
+                members.push(member("joint_pos", floats(u, vec![frames, nq - 7], base)?));
+                members
+                    .push(member("body_pos_w", floats(u, vec![frames, b, 3], &[0.0, 0.0, 0.79])?));
+                let identity = [1.0, 0.0, 0.0, 0.0];
+                members.push(member("body_quat_w", floats(u, vec![frames, b, 4], &identity)?));
             }
             _ => {}
         }
         if u.arbitrary()? {
-            let bools: Vec<u8> =
-                (0..frames).map(|_| u.arbitrary::<bool>().map(u8::from)).collect::<Result<_>>()?;
-            members.push(member(
-                "contact_left",
-                "|b1".to_owned(),
-                &format!("({frames},)"),
-                bools.clone(),
-            ));
-            members.push(member("contact_right", "|b1".to_owned(), &format!("({frames},)"), bools));
+            let bools: Vec<bool> = (0..frames).map(|_| u.arbitrary()).collect::<Result<_>>()?;
+            members.push(member("contact_left", Array::bools(&bools)));
+            members.push(member("contact_right", Array::bools(&bools)));
         }
         if u.arbitrary()? {
-            let names = vec!["pelvis".to_owned(), "left_ankle_roll_link".to_owned()];
-            members.push(member(
-                "target_body_names",
-                format!("<U{}", width(&names)),
-                "(2,)",
-                strings(&names),
-            ));
-            members.push(member(
-                "target_pos",
-                "<f8".to_owned(),
-                &format!("({frames}, 2, 3)"),
-                floats(u, frames * 6, &[0.0, 0.0, 0.8])?,
-            ));
-            members.push(member(
-                "target_quat",
-                "<f8".to_owned(),
-                &format!("({frames}, 2, 4)"),
-                floats(u, frames * 8, &[1.0, 0.0, 0.0, 0.0])?,
-            ));
+            let names = ["pelvis".to_owned(), "left_ankle_roll_link".to_owned()];
+            members.push(member("target_body_names", Array::strings(&names)));
+            members.push(member("target_pos", floats(u, vec![frames, 2, 3], &[0.0, 0.0, 0.8])?));
+            let identity = [1.0, 0.0, 0.0, 0.0];
+            members.push(member("target_quat", floats(u, vec![frames, 2, 4], &identity)?));
         }
         Ok(members)
     }
@@ -1130,6 +1057,30 @@ impl NpzTarget {
         let bytes = written.ok().and_then(|()| std::fs::read(&path).ok()).unwrap_or_default();
         let _ = std::fs::remove_dir_all(&dir);
         bytes
+    }
+}
+
+/// The `npz` crate's ways of reading a member give the same numbers: whole (`array`), as
+/// `f64`s (`floats`) and streamed in rows of its last dimension (`rows`); a disagreement is a
+/// bug (a panic, which the harness reports).
+fn readers_agree(input: &[u8], name: &std::path::Path) {
+    let Ok(mut npz) = npz::Npz::new(Cursor::new(input), name) else { return };
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for key in npz.keys() {
+        let Ok(array) = npz.array(&key) else { continue };
+        let numbers = match &array.data {
+            ArrayData::F64(v) => v.clone(),
+            ArrayData::Bool(v) => v.iter().map(|&b| f64::from(u8::from(b))).collect(),
+            ArrayData::Str(_) => continue,
+        };
+        let floats = npz.floats(&key).ok().map(|(shape, v)| (shape, bits(&v)));
+        assert_eq!(floats, Some((array.shape.clone(), bits(&numbers))), "`{key}`: floats ≠ array");
+        let row = array.shape.last().copied().unwrap_or(1);
+        if row > 0 {
+            let mut streamed = Vec::new();
+            let shape = npz.rows(&key, row, |_, r| streamed.extend_from_slice(r));
+            assert!(shape.is_ok() && bits(&streamed) == bits(&numbers), "`{key}`: rows ≠ array");
+        }
     }
 }
 
@@ -1172,6 +1123,7 @@ impl Target for NpzTarget {
 
     fn run(&self, input: &[u8]) -> std::result::Result<(), String> {
         let name = std::path::Path::new("fuzz.npz");
+        readers_agree(input, name);
         // Our own reader, then the reader of every .npz layout, whose motion is reported.
         let _ = retarget::writers::read_motion_npz_bytes(input, name).map(|m| m.num_frames());
         let (motion, _) = retarget::writers::read_motion_bytes(input, name, g1(), None)

@@ -17,7 +17,7 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    /// A file the writers or the `.npz` reader could not create, write or open.
+    /// A file the writers could not create or write, or a motion file that could not be read.
     #[error("{}: {source}", path.display())]
     File {
         path: PathBuf,
@@ -71,6 +71,10 @@ pub enum Error {
     /// An SMPL-X / SMPL+H body model or AMASS motion that cannot be read or posed.
     #[error(transparent)]
     Smpl(#[from] smpl::Error),
+    /// An `.npz` that cannot be read: not a zip, an array missing, or one that cannot be read
+    /// (the message names the file and the array).
+    #[error(transparent)]
+    Npz(#[from] npz::Error),
     /// A C3D file that does not parse.
     #[error(transparent)]
     C3d(#[from] c3d::Error),

@@ -5,84 +5,15 @@
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
-use std::io::Read;
 use std::path::Path;
 
 use retarget::{IkConfig, RetargetOptions};
 
-/// A `.npy` array as shape + f64 data, or as strings.
-enum Npy {
-    F64(Vec<usize>, Vec<f64>),
-    Str(Vec<String>),
-}
-
-fn read_npz(path: &Path) -> Vec<(String, Npy)> {
-    let file = std::fs::File::open(path).unwrap();
-    let mut zip = zip::ZipArchive::new(file).unwrap();
-    let mut out = Vec::new();
-    for i in 0..zip.len() {
-        let mut entry = zip.by_index(i).unwrap();
-        let name = entry.name().trim_end_matches(".npy").to_owned();
-        let mut bytes = Vec::new();
-        entry.read_to_end(&mut bytes).unwrap();
-        out.push((name, parse_npy(&bytes)));
-    }
-    out
-}
-
-/// Minimal npy v1 reader: little-endian `<f8` and `<U<n>`, C order.
-fn parse_npy(bytes: &[u8]) -> Npy {
-    assert_eq!(&bytes[..6], b"\x93NUMPY");
-    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
-    let data = &bytes[10 + len..];
-    let descr = header.split("'descr': '").nth(1).unwrap().split('\'').next().unwrap();
-    let shape_text = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
-    let shape: Vec<usize> = shape_text
-        .split(',')
-        .filter(|s| !s.trim().is_empty())
-        .map(|s| s.trim().parse().unwrap())
-        .collect();
-    if descr == "<f8" {
-        let values =
-            data.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
-        Npy::F64(shape, values)
-    } else if let Some(n) = descr.strip_prefix("<U") {
-        let n: usize = n.parse().unwrap();
-        let strings = data
-            .chunks_exact(4 * n)
-            .map(|c| {
-                c.chunks_exact(4)
-                    .map(|u| u32::from_le_bytes(u.try_into().unwrap()))
-                    .take_while(|&u| u != 0)
-                    .map(|u| char::from_u32(u).unwrap())
-                    .collect()
-            })
-            .collect();
-        Npy::Str(strings)
-    } else {
-        panic!("unsupported dtype {descr}")
-    }
-}
-
-fn f64s<'a>(npz: &'a [(String, Npy)], key: &str) -> (&'a [usize], &'a [f64]) {
-    match npz.iter().find(|(k, _)| k == key) {
-        Some((_, Npy::F64(shape, data))) => (shape, data),
-        _ => panic!("no f64 array {key}"),
-    }
-}
-
-fn strings<'a>(npz: &'a [(String, Npy)], key: &str) -> &'a [String] {
-    match npz.iter().find(|(k, _)| k == key) {
-        Some((_, Npy::Str(s))) => s,
-        _ => panic!("no string array {key}"),
-    }
-}
-
 #[test]
 fn lafan1_walk_on_g1_matches_gmr() {
     let Some(shared) = shared::shared_dir() else { return };
-    let npz = read_npz(&shared.join("reference/gmr_outputs/unitree_g1_lafan1_walk.npz"));
+    let mut npz =
+        npz::Npz::open(&shared.join("reference/gmr_outputs/unitree_g1_lafan1_walk.npz")).unwrap();
     let bvh = bvh::from_path(&shared.join("data/bvh/lafan1_take_via_bvhtools_test.bvh")).unwrap();
     let model =
         mjcf::Model::from_file(&shared.join("reference/robots/unitree_g1/g1_mocap_29dof.xml"))
@@ -103,13 +34,13 @@ fn lafan1_walk_on_g1_matches_gmr() {
     let (motion, diag) =
         retarget::internals::retarget_bvh(&bvh, &model, &config, &options).unwrap();
 
-    let (qshape, gmr_q) = f64s(&npz, "qpos");
-    assert_eq!(qshape, &[motion.num_frames(), motion.nq]);
+    let (qshape, gmr_q) = npz.floats("qpos").unwrap();
+    assert_eq!(qshape, [motion.num_frames(), motion.nq]);
     let targets = motion.targets.as_ref().unwrap();
-    assert_eq!(targets.body_names, strings(&npz, "body_names"));
+    assert_eq!(targets.body_names, npz.strings("body_names").unwrap());
     let nb = targets.body_names.len();
-    let (_, gmr_pos) = f64s(&npz, "targets_pos");
-    let (_, gmr_quat) = f64s(&npz, "targets_quat");
+    let (_, gmr_pos) = npz.floats("targets_pos").unwrap();
+    let (_, gmr_quat) = npz.floats("targets_quat").unwrap();
     let mut max_pos = 0.0_f64;
     let mut max_quat = 0.0_f64;
     for (k, (p, q)) in targets.pos.iter().zip(&targets.quat).enumerate() {

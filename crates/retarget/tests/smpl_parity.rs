@@ -18,8 +18,8 @@ use std::path::{Path, PathBuf};
 
 use fk::HumanMotion;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use npz::Npz;
 use retarget::{IkConfig, Retargeter, SolveMode};
-use smpl::npz::Npz;
 
 /// Largest |qpos − GMR's| allowed (rad, m), the float32 rounding of GMR's human data.
 const TOLERANCE: f64 = 1e-5;

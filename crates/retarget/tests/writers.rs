@@ -170,16 +170,16 @@ fn crafted_npz_headers_are_errors_not_allocations() {
     };
     let cases = [
         ("<U0", "(100000000000000,)", "dtype <U0 with 100000000000000 elements in 0 bytes"),
-        ("<U4", "(100000000000000,)", "array data truncated (<U4, 100000000000000 elements)"),
-        ("<f8", "(4294967296, 65536)", "array data truncated"),
+        ("<U4", "(100000000000000,)", "data truncated (fewer than the 100000000000000 elements"),
+        ("<f8", "(4294967296, 65536)", "data truncated"),
         ("<f8", "(4294967296, 4294967296, 4294967296)", "shape overflows"),
-        ("<U99999999999999999999", "(1,)", "bad dtype"),
+        ("<U99999999999999999999", "(1,)", "unsupported dtype `<U99999999999999999999`"),
     ];
     for (descr, shape, expected) in cases {
         let path = dir.join("crafted.npz");
         npz_with(&path, "joint_names", &npy(descr, shape));
         let err = read_motion_npz(&path).unwrap_err().to_string();
-        assert!(err.contains("crafted.npz") && err.contains("joint_names"), "{err}");
+        assert!(err.contains("crafted.npz: array `joint_names`: "), "{err}");
         assert!(err.contains(expected), "{descr} {shape}: {err}");
     }
 }

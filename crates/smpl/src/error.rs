@@ -8,27 +8,10 @@ use crate::conventions::{Gender, ModelKind};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    /// Not a readable `.npz` (zip) archive.
-    #[error("{}: not an .npz file: {message}", path.display())]
-    NotNpz { path: PathBuf, message: String },
-    /// An array the reader needs is not in the file.
-    #[error("{}: no `{key}` array (the file has: {})", path.display(), available.join(", "))]
-    Missing { path: PathBuf, key: String, available: Vec<String> },
-    /// An array that cannot be read as needed (dtype, shape, truncated data).
-    #[error("{}: array `{key}`: {message}", path.display())]
-    Array { path: PathBuf, key: String, message: String },
-    /// An array the reader needs is a pickled Python object, which is never unpickled.
-    #[error(
-        "{}: array `{key}` is a pickled Python object (dtype object), which is not read",
-        path.display()
-    )]
-    Pickled { path: PathBuf, key: String },
+    /// A file that cannot be opened, is not an `.npz`, lacks an array the reader needs, or
+    /// has one that cannot be read as needed (dtype, shape, truncated data, pickled objects).
+    #[error(transparent)]
+    Npz(#[from] npz::Error),
     /// A body model given as a Python pickle.
     #[error(
         "{}: a .pkl body model is a Python pickle, which this tool does not read; use the \

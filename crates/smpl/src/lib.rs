@@ -26,7 +26,6 @@ pub mod gmr;
 mod model;
 mod models;
 mod motion;
-pub mod npz;
 
 pub use conventions::{Gender, ModelKind, BODY_MODELS_ENV};
 pub use error::Error;

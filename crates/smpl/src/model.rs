@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::conventions::{Gender, ModelKind};
-use crate::npz::Npz;
 use crate::Error;
+use npz::Npz;
 
 /// Vertices kept at the top of the head and under the soles to measure the stature.
 const EXTREME_VERTICES: usize = 24;

@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::conventions::{Gender, ModelKind};
-use crate::npz::Npz;
 use crate::Error;
+use npz::Npz;
 
 /// One motion: who (model kind, gender, betas), how fast, and every frame's pose.
 #[derive(Debug, Clone, PartialEq)]
@@ -206,11 +206,12 @@ fn kind_of<R: std::io::Read + std::io::Seek>(keys: &mut Keys<'_, R>) -> Result<M
             ))
         }),
         (None, None) if keys.npz.has("pose_body") => Ok(ModelKind::SmplX),
-        (None, None) => Err(Error::Missing {
+        (None, None) => Err(npz::Error::Missing {
             path: keys.npz.path().to_path_buf(),
             key: "poses".to_owned(),
             available: keys.npz.keys(),
-        }),
+        }
+        .into()),
     }
 }
 

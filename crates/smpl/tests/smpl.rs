@@ -9,7 +9,7 @@ mod shared;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use smpl::npz::Npz;
+use npz::Npz;
 use smpl::{BodyModel, BodyModels, Error, Gender, ModelKind, SmplMotion};
 
 fn reference() -> Option<PathBuf> {

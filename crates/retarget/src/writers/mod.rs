@@ -17,7 +17,6 @@
 mod csv;
 mod derived;
 mod json;
-pub mod npy;
 mod npz;
 mod pickle;
 mod read;
@@ -110,7 +109,7 @@ pub fn write_motion(
     match format {
         Format::Npz => {
             let arrays = npz::motion_arrays(motion, model);
-            write_atomically(path, |w| npz::write_npz(w, &arrays))
+            write_atomically(path, |w| ::npz::write(w, &arrays))
         }
         Format::Csv => write_atomically(path, |w| csv::write_csv(w, motion, model)),
         Format::Pkl => {
@@ -121,11 +120,11 @@ pub fn write_motion(
     }
 }
 
-/// Writes `arrays` (name, array, in file order) as an `.npz` in numpy's `savez_compressed`
-/// layout, atomically ([`write_atomically`]): for arrays other than a robot motion's (the
-/// CLI's export of a human motion).
-pub fn write_npz(path: &Path, arrays: &[(&str, npy::Array)]) -> Result<(), Error> {
-    write_atomically(path, |w| npz::write_npz(w, arrays))
+/// Writes `arrays` (name, array, in file order) as an `.npz` in numpy's `savez` layout
+/// ([`::npz::write()`]), atomically ([`write_atomically`]): for arrays other than a robot
+/// motion's (the CLI's export of a human motion).
+pub fn write_npz(path: &Path, arrays: &[(&str, ::npz::Array)]) -> Result<(), Error> {
+    write_atomically(path, |w| ::npz::write(w, arrays))
 }
 
 /// The arrays [`write_motion`] puts in an `.npz`, in file order, by key (checked as
@@ -133,7 +132,7 @@ pub fn write_npz(path: &Path, arrays: &[(&str, npy::Array)]) -> Result<(), Error
 pub fn npz_arrays(
     motion: &RobotMotion,
     model: &mjcf::Model,
-) -> Result<Vec<(&'static str, npy::Array)>, Error> {
+) -> Result<Vec<(&'static str, ::npz::Array)>, Error> {
     check_motion(motion, model)?;
     Ok(npz::motion_arrays(motion, model))
 }

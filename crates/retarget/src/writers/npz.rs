@@ -1,17 +1,15 @@
-//! `.npz`: numpy's zip archive of `<key>.npy` members (as `numpy.savez_compressed` writes it:
-//! deflate), and the reader for our own files.
+//! Our `.npz`: a motion's arrays (written by the `npz` crate) and the motion read back from
+//! them.
 
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::{Read, Seek, Write};
 use std::path::Path;
 
+use ::npz::{Array, Npz};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use super::npy::{self, Array, ArrayData};
 use super::{angular_velocity, body_poses, gradient_rows, root_nq, Error};
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
 
@@ -69,74 +67,9 @@ fn wxyz_flat(quats: &[UnitQuaternion<f64>]) -> Vec<f64> {
     quats.iter().flat_map(|q| [q.w, q.i, q.j, q.k]).collect()
 }
 
-/// Writes `arrays` as an `.npz` with stored (uncompressed) members `<key>.npy`, as numpy's
-/// `savez` does. Deflate saved only ~7 % on a LAFAN1 G1 clip (float64 data is mostly
-/// mantissa noise) and cost ~1 s of a 2 s run, so it is not worth it.
-pub(crate) fn write_npz<W: Write + Seek>(out: W, arrays: &[(&str, Array)]) -> std::io::Result<()> {
-    let mut zip = zip::ZipWriter::new(out);
-    for (key, array) in arrays {
-        let bytes = npy::encode(array);
-        let options = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Stored)
-            .large_file(bytes.len() as u64 >= u64::from(u32::MAX));
-        zip.start_file(format!("{key}.npy"), options).map_err(std::io::Error::other)?;
-        zip.write_all(&bytes)?;
-    }
-    zip.finish().map_err(std::io::Error::other)?;
-    Ok(())
-}
-
-/// Deflate's largest expansion: 258 bytes from a 2-bit code, i.e. about 1032 to 1 (zlib's
-/// technical details, "Maximum compression factor").
-const MAX_DEFLATE_RATIO: u64 = 1032;
-
-/// Every `<key>.npy` of an `.npz`, by key. Allocations are bounded by the file's size.
+/// Every `<key>.npy` of the `.npz` at `path`, by key.
 fn read_npz(path: &Path) -> Result<BTreeMap<String, Array>, Error> {
-    let file =
-        File::open(path).map_err(|source| Error::File { path: path.to_path_buf(), source })?;
-    read_npz_from(file, path)
-}
-
-/// [`read_npz`] on any reader; `path` names it in errors.
-pub(super) fn read_npz_from<R: Read + Seek>(
-    mut reader: R,
-    path: &Path,
-) -> Result<BTreeMap<String, Array>, Error> {
-    let read_error = |message: String| Error::Read { path: path.to_path_buf(), message };
-    let io_error = |source| Error::File { path: path.to_path_buf(), source };
-    // The archive's real length: the only size in it that the file cannot lie about.
-    let file_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io_error)?;
-    reader.seek(std::io::SeekFrom::Start(0)).map_err(io_error)?;
-    let mut zip =
-        zip::ZipArchive::new(reader).map_err(|e| read_error(format!("not an .npz: {e}")))?;
-    let mut arrays = BTreeMap::new();
-    for i in 0..zip.len() {
-        let mut member = zip.by_index(i).map_err(|e| read_error(e.to_string()))?;
-        let Some(key) = member.name().strip_suffix(".npy").map(str::to_owned) else { continue };
-        // Sizes in the headers are the file's word: the compressed size cannot exceed the
-        // archive, the declared size cannot exceed what those bytes inflate to (deflate
-        // expands at most 1032:1), reading stops at the declared size, and the buffer starts
-        // no larger than the archive (it grows only with bytes really inflated).
-        let (size, packed) = (member.size(), member.compressed_size().min(file_len));
-        let bound = match member.compression() {
-            zip::CompressionMethod::Stored => packed,
-            _ => packed.saturating_mul(MAX_DEFLATE_RATIO).saturating_add(1024),
-        };
-        if size > bound {
-            return Err(read_error(format!(
-                "{key}: member claims {size} bytes from {packed} stored bytes"
-            )));
-        }
-        let mut bytes = Vec::with_capacity(usize::try_from(size.min(file_len)).unwrap_or(0));
-        member
-            .by_ref()
-            .take(size)
-            .read_to_end(&mut bytes)
-            .map_err(|e| read_error(format!("{key}: {e}")))?;
-        let array = npy::decode(&bytes).map_err(|e| read_error(format!("{key}: {e}")))?;
-        arrays.insert(key, array);
-    }
-    Ok(arrays)
+    Ok(Npz::open(path)?.arrays()?)
 }
 
 /// Reads a motion back from an `.npz` written by [`super::write_motion`] (or any `.npz` with
@@ -149,23 +82,25 @@ pub fn read_motion_npz(path: &Path) -> Result<RobotMotion, Error> {
 
 /// [`read_motion_npz`] on the bytes of an `.npz` (`name` is used in errors).
 pub fn read_motion_npz_bytes(bytes: &[u8], name: &Path) -> Result<RobotMotion, Error> {
-    motion_from_arrays(&read_npz_from(std::io::Cursor::new(bytes), name)?, name)
+    let arrays = Npz::new(std::io::Cursor::new(bytes), name)?.arrays()?;
+    motion_from_arrays(&arrays, name)
 }
 
 fn motion_from_arrays(arrays: &BTreeMap<String, Array>, path: &Path) -> Result<RobotMotion, Error> {
     let err = |message: String| Error::Read { path: path.to_path_buf(), message };
     let get = |key: &str| arrays.get(key).ok_or_else(|| err(format!("no `{key}` array")));
-    let fps = match floats(get("fps")?) {
+    let fps = match get("fps")?.as_f64() {
         Some([fps]) => *fps,
         _ => return Err(err("`fps` is not a single number".to_owned())),
     };
     let qpos = get("qpos")?;
-    let (Some(values), [frames, nq]) = (floats(qpos), qpos.shape.as_slice()) else {
+    let (Some(values), [frames, nq]) = (qpos.as_f64(), qpos.shape.as_slice()) else {
         return Err(err("`qpos` is not a 2-D float array".to_owned()));
     };
     let joint_names =
-        strings(get("joint_names")?).ok_or_else(|| err("bad `joint_names`".into()))?;
-    let body_names = strings(get("body_names")?).ok_or_else(|| err("bad `body_names`".into()))?;
+        get("joint_names")?.as_strings().ok_or_else(|| err("bad `joint_names`".into()))?;
+    let body_names =
+        get("body_names")?.as_strings().ok_or_else(|| err("bad `body_names`".into()))?;
     let targets = match arrays.get("target_body_names") {
         None => None,
         Some(names) => Some(
@@ -191,7 +126,7 @@ fn motion_from_arrays(arrays: &BTreeMap<String, Array>, path: &Path) -> Result<R
 /// The `robot` name stored in an `.npz` by [`super::write_motion`], if any.
 pub fn read_npz_robot(path: &Path) -> Result<Option<String>, Error> {
     let arrays = read_npz(path)?;
-    Ok(arrays.get("robot").and_then(strings).and_then(|s| s.first().cloned()))
+    Ok(arrays.get("robot").and_then(Array::as_strings).and_then(|s| s.first().cloned()))
 }
 
 pub(super) fn read_targets(
@@ -200,9 +135,9 @@ pub(super) fn read_targets(
     quat: &Array,
     frames: usize,
 ) -> Result<TrackedTargets, String> {
-    let names = strings(names).ok_or("bad `target_body_names`")?;
+    let names = names.as_strings().ok_or("bad `target_body_names`")?;
     let k = names.len();
-    let (Some(p), Some(q)) = (floats(pos), floats(quat)) else {
+    let (Some(p), Some(q)) = (pos.as_f64(), quat.as_f64()) else {
         return Err("`target_pos` and `target_quat` must be float arrays".to_owned());
     };
     if pos.shape != [frames, k, 3] || quat.shape != [frames, k, 4] {
@@ -234,8 +169,8 @@ pub(super) fn read_contacts(
     right: &Array,
     frames: usize,
 ) -> Result<FootContacts, String> {
-    let side = |a: &Array, key: &str| match &a.data {
-        ArrayData::Bool(v) if a.shape == [frames] => Ok(v.clone()),
+    let side = |a: &Array, key: &str| match a.as_bools() {
+        Some(v) if a.shape == [frames] => Ok(v.to_vec()),
         _ => Err(format!("`{key}` is not a bool array of {frames} frames")),
     };
     Ok(FootContacts {
@@ -243,43 +178,4 @@ pub(super) fn read_contacts(
         right: side(right, "contact_right")?,
         on_toes: None,
     })
-}
-
-pub(super) fn floats(a: &Array) -> Option<&[f64]> {
-    match &a.data {
-        ArrayData::F64(v) => Some(v),
-        ArrayData::Str(_) | ArrayData::Bool(_) => None,
-    }
-}
-
-pub(super) fn strings(a: &Array) -> Option<&[String]> {
-    match &a.data {
-        ArrayData::Str(v) => Some(v),
-        ArrayData::F64(_) | ArrayData::Bool(_) => None,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn npz_members_round_trip() {
-        let arrays = [
-            ("fps", Array::f64(vec![1], vec![30.0])),
-            ("names", Array::strings(&["a".to_owned(), "bc".to_owned()])),
-            ("contact", Array::bools(&[true, false, false, true])),
-        ];
-        let mut buf = std::io::Cursor::new(Vec::new());
-        write_npz(&mut buf, &arrays).unwrap();
-        let dir = std::env::temp_dir().join(format!("retarget-npz-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("a.npz");
-        std::fs::write(&path, buf.into_inner()).unwrap();
-        let back = read_npz(&path).unwrap();
-        assert_eq!(back["fps"], arrays[0].1);
-        assert_eq!(back["names"], arrays[1].1);
-        assert_eq!(back["contact"], arrays[2].1);
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
 }

@@ -17,8 +17,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::npy::Array;
-use super::npz::{floats, read_contacts, read_npz_from, read_targets, strings};
+use ::npz::{Array, Npz};
+
+use super::npz::{read_contacts, read_targets};
 use super::unpickle;
 use super::{root_nq, wxyz_from_xyzw};
 use crate::motion::RobotMotion;
@@ -105,7 +106,7 @@ pub fn read_motion_bytes(
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match (bytes, ext.as_deref()) {
         ([b'P', b'K', ..], _) | (_, Some("npz")) => {
-            let arrays = read_npz_from(std::io::Cursor::new(bytes), path)?;
+            let arrays = Npz::new(std::io::Cursor::new(bytes), path)?.arrays()?;
             reader.npz(&arrays)
         }
         ([0x80, ..], _) | (_, Some("pkl" | "pickle")) => reader.pickle(bytes),
@@ -214,7 +215,7 @@ impl Reader<'_> {
     fn npz(&self, arrays: &BTreeMap<String, Array>) -> Result<(RobotMotion, MotionSource), Error> {
         let stored = match arrays.get("fps") {
             None => None,
-            Some(a) => match floats(a) {
+            Some(a) => match a.as_f64() {
                 Some(&[fps]) => Some(fps),
                 _ => return Err(self.error("`fps` is not a single number".to_owned())),
             },
@@ -254,7 +255,7 @@ impl Reader<'_> {
         fps: f64,
     ) -> Result<(RobotMotion, MotionFormat), Error> {
         let qpos = arrays.get("qpos").ok_or_else(|| self.error("no `qpos` array".to_owned()))?;
-        let (Some(values), [_, width]) = (floats(qpos), qpos.shape.as_slice()) else {
+        let (Some(values), [_, width]) = (qpos.as_f64(), qpos.shape.as_slice()) else {
             return Err(
                 self.error(format!("`qpos` is not a 2-D number array (shape {:?})", qpos.shape))
             );
@@ -262,12 +263,12 @@ impl Reader<'_> {
         self.check_width("`qpos`", *width, true)?;
         let model_joints = RobotMotion::model_joint_names(self.model);
         if let Some(names) = arrays.get("joint_names") {
-            let names = strings(names).ok_or_else(|| self.error("bad `joint_names`".into()))?;
+            let names = names.as_strings().ok_or_else(|| self.error("bad `joint_names`".into()))?;
             self.same_joints(names, &model_joints)?;
         }
         let ours = arrays
             .get("body_names")
-            .and_then(strings)
+            .and_then(Array::as_strings)
             .is_some_and(|b| b == RobotMotion::model_body_names(self.model).as_slice());
         let format = if ours && arrays.contains_key("joint_names") {
             MotionFormat::Npz
@@ -305,11 +306,11 @@ impl Reader<'_> {
             arrays.get(key).ok_or_else(|| self.error(format!("BeyondMimic .npz without `{key}`")))
         };
         let (joint_pos, pos, quat) = (get("joint_pos")?, get("body_pos_w")?, get("body_quat_w")?);
-        let (Some(jp), [frames, width]) = (floats(joint_pos), joint_pos.shape.as_slice()) else {
+        let (Some(jp), [frames, width]) = (joint_pos.as_f64(), joint_pos.shape.as_slice()) else {
             return Err(self.error(format!("`joint_pos` is not 2-D (shape {:?})", joint_pos.shape)));
         };
         self.check_width("`joint_pos`", *width, false)?;
-        let (Some(p), Some(q)) = (floats(pos), floats(quat)) else {
+        let (Some(p), Some(q)) = (pos.as_f64(), quat.as_f64()) else {
             return Err(self.error("`body_pos_w` and `body_quat_w` must be numbers".to_owned()));
         };
         let bodies = match pos.shape.as_slice() {
@@ -343,7 +344,7 @@ impl Reader<'_> {
     /// file has `body_names`, else 0.
     fn root_body_index(&self, names: Option<&Array>, bodies: usize) -> Result<usize, Error> {
         let Some(names) = names else { return Ok(0) };
-        let names = strings(names).ok_or_else(|| self.error("bad `body_names`".to_owned()))?;
+        let names = names.as_strings().ok_or_else(|| self.error("bad `body_names`".to_owned()))?;
         if names.len() != bodies {
             return Err(self.error(format!(
                 "{} `body_names` for {bodies} bodies in `body_pos_w`",
@@ -363,7 +364,7 @@ impl Reader<'_> {
     /// Column of the file's `joint_pos` for each of the model's joint coordinates, by name
     /// (every joint but the free one must take one coordinate for a reordering).
     fn joint_order(&self, names: &Array) -> Result<Vec<usize>, Error> {
-        let names = strings(names).ok_or_else(|| self.error("bad `joint_names`".to_owned()))?;
+        let names = names.as_strings().ok_or_else(|| self.error("bad `joint_names`".to_owned()))?;
         let model_joints = RobotMotion::model_joint_names(self.model);
         let one_dof = self.model.joints.iter().all(|j| {
             matches!(
@@ -614,7 +615,7 @@ mod tests {
             ("qpos", Array::f64(vec![2, 29], vec![0.0; 58])),
         ];
         let mut buf = std::io::Cursor::new(Vec::new());
-        super::super::npz::write_npz(&mut buf, &arrays).unwrap();
+        ::npz::write(&mut buf, &arrays).unwrap();
         let err = read_motion_bytes(buf.get_ref(), Path::new("j.npz"), &model, None).unwrap_err();
         let text = err.to_string();
         assert!(text.starts_with("j.npz: `qpos` has 29 columns, but robot"), "{text}");
@@ -642,7 +643,7 @@ mod tests {
             ("body_quat_w", Array::f64(vec![2, bodies, 4], quat)),
         ];
         let mut buf = std::io::Cursor::new(Vec::new());
-        super::super::npz::write_npz(&mut buf, &arrays).unwrap();
+        ::npz::write(&mut buf, &arrays).unwrap();
         let (m, source) =
             read_motion_bytes(buf.get_ref(), Path::new("b.npz"), &model, None).unwrap();
         assert_eq!(source.format, MotionFormat::BeyondMimic);
