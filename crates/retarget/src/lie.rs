@@ -196,13 +196,10 @@ fn so3_ljacinv_with(omega: &Vector3<f64>, theta: f64, (st, ct): (f64, f64)) -> M
     out
 }
 
-/// The Q block of the SE(3) left Jacobian (eq. 180), `c = [v; ω]`, given `θ = |ω|` and
-/// `(sin θ, cos θ)`.
-fn q_block(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
-    let v = Vector3::new(c[0], c[1], c[2]);
-    let w = Vector3::new(c[3], c[4], c[5]);
+/// The Q block's four coefficients (eq. 180) at `θ` with `(sin θ, cos θ)`: its Taylor
+/// series near 0.
+fn q_coefficients(theta: f64, (st, ct): (f64, f64)) -> (f64, f64, f64, f64) {
     let t2 = theta * theta;
-    let a = 0.5;
     let (b, cc, d) = if t2 < EPS {
         (1.0 / 6.0 + (1.0 / 120.0) * t2, -(1.0 / 24.0) + (1.0 / 720.0) * t2, -(1.0 / 60.0))
     } else {
@@ -213,6 +210,15 @@ fn q_block(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
             (2.0 * theta - 3.0 * st + theta * ct) / (2.0 * t4 * theta),
         )
     };
+    (0.5, b, cc, d)
+}
+
+/// The Q block of the SE(3) left Jacobian (eq. 180), `c = [v; ω]`, given `θ = |ω|` and
+/// `(sin θ, cos θ)`.
+fn q_block(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
+    let v = Vector3::new(c[0], c[1], c[2]);
+    let w = Vector3::new(c[3], c[4], c[5]);
+    let (a, b, cc, d) = q_coefficients(theta, (st, ct));
     let vs = skew(&v);
     let ws = skew(&w);
     // Products with a skew matrix, its zero diagonal's terms left out (`mul3_sparse`).
@@ -316,18 +322,7 @@ mod tests {
     fn q_block_reference(c: &Vector6<f64>, theta: f64, (st, ct): (f64, f64)) -> Matrix3<f64> {
         let v = Vector3::new(c[0], c[1], c[2]);
         let w = Vector3::new(c[3], c[4], c[5]);
-        let t2 = theta * theta;
-        let a = 0.5;
-        let (b, cc, d) = if t2 < EPS {
-            (1.0 / 6.0 + (1.0 / 120.0) * t2, -(1.0 / 24.0) + (1.0 / 720.0) * t2, -(1.0 / 60.0))
-        } else {
-            let t4 = t2 * t2;
-            (
-                (theta - st) / (t2 * theta),
-                (1.0 - 0.5 * t2 - ct) / t4,
-                (2.0 * theta - 3.0 * st + theta * ct) / (2.0 * t4 * theta),
-            )
-        };
+        let (a, b, cc, d) = q_coefficients(theta, (st, ct));
         let vs = skew(&v);
         let ws = skew(&w);
         let vw = vs * ws;
