@@ -34,13 +34,15 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
 mod array;
+mod dtype;
 mod error;
 mod npy;
 mod read;
 mod write;
 
 pub use array::{Array, ArrayData};
+pub use dtype::Dtype;
 pub use error::{Error, Problem};
-pub use npy::{Dtype, Header};
+pub use npy::Header;
 pub use read::Npz;
 pub use write::write;
