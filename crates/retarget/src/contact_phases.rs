@@ -125,27 +125,32 @@ fn foot_contact(
     let mut contact = vec![false; n];
     let mut on = false;
     for (t, c) in contact.iter_mut().enumerate() {
-        let grips = points.iter().any(|p| p.height[t] < o.height_on && p.speed[t] < o.speed_on);
-        let holds = points.iter().any(|p| p.height[t] < o.height_off && p.speed[t] < o.speed_off);
-        on = if on { holds } else { grips };
+        on = if on {
+            points.iter().any(|p| p.holds(t, o))
+        } else {
+            points.iter().any(|p| p.grips(t, o))
+        };
         *c = on;
     }
     let min_frames = (o.min_phase_s * human.fps).round().max(1.0) as usize;
-    fill_short_runs(&mut contact, false, min_frames);
-    fill_short_runs(&mut contact, true, min_frames);
+    settle(&mut contact, min_frames);
     let on_toes = match points.as_slice() {
         [heel, toe] => {
-            let holds =
-                |p: &PointTrack, t: usize| p.height[t] < o.height_off && p.speed[t] < o.speed_off;
             let mut toes: Vec<bool> =
-                (0..n).map(|t| contact[t] && holds(toe, t) && !holds(heel, t)).collect();
-            fill_short_runs(&mut toes, false, min_frames);
-            fill_short_runs(&mut toes, true, min_frames);
+                (0..n).map(|t| contact[t] && toe.holds(t, o) && !heel.holds(t, o)).collect();
+            settle(&mut toes, min_frames);
             Some(toes.iter().zip(&contact).map(|(a, c)| *a && *c).collect())
         }
         _ => None,
     };
     (contact, on_toes)
+}
+
+/// Labels with their gaps and runs shorter than `min` frames filled and dropped
+/// ([`fill_short_runs`], gaps first).
+fn settle(labels: &mut [bool], min: usize) {
+    fill_short_runs(labels, false, min);
+    fill_short_runs(labels, true, min);
 }
 
 /// Runs of `value` shorter than `min` frames become `!value`, but those that the clip's
@@ -240,6 +245,16 @@ struct PointTrack {
 }
 
 impl PointTrack {
+    /// Whether the point grips the floor at frame `t`: low and slow enough to enter contact.
+    fn grips(&self, t: usize, o: &ContactOptions) -> bool {
+        self.height[t] < o.height_on && self.speed[t] < o.speed_on
+    }
+
+    /// Whether the point holds the floor at frame `t`: low and slow enough to stay in contact.
+    fn holds(&self, t: usize, o: &ContactOptions) -> bool {
+        self.height[t] < o.height_off && self.speed[t] < o.speed_off
+    }
+
     fn new(human: &HumanMotion, body: usize, floor_percentile: f64) -> PointTrack {
         let n = human.num_frames;
         let nb = human.num_bodies();

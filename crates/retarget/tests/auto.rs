@@ -7,7 +7,7 @@
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use fk::{Part, Role, Side};
 use nalgebra::{UnitQuaternion, Vector3};
@@ -255,6 +255,17 @@ fn assert_sane(what: &str, c: &Checks, walk: bool) {
     }
 }
 
+/// The files of `dir` whose extension is `ext`, sorted.
+fn files_in(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    files.sort();
+    files
+}
+
 fn shipped_model(key: &str) -> mjcf::Model {
     mjcf::Model::from_file(&root().join(format!("robots/{key}/{key}.xml"))).unwrap()
 }
@@ -262,12 +273,7 @@ fn shipped_model(key: &str) -> mjcf::Model {
 #[test]
 fn every_shared_bvh_onto_the_g1_and_the_t1() {
     let Some(dir) = shared::shared_file("data/bvh") else { return };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
-        .collect();
-    files.sort();
+    let files = files_in(&dir, "bvh");
     assert!(files.len() >= 13, "{files:?}");
     for key in ["unitree_g1", "booster_t1_29dof"] {
         let model = shipped_model(key);
@@ -299,12 +305,7 @@ fn every_shared_bvh_onto_the_g1_and_the_t1() {
 #[test]
 fn every_soma_take_onto_the_g1() {
     let Some(dir) = shared::shared_file("data/soma") else { return };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "bvh"))
-        .collect();
-    files.sort();
+    let files = files_in(&dir, "bvh");
     assert_eq!(files.len(), 4, "{files:?}");
     let key = "unitree_g1";
     let model = shipped_model(key);
@@ -329,12 +330,7 @@ fn every_soma_take_onto_the_g1() {
 #[test]
 fn every_shared_fbx_onto_the_g1_and_the_t1_in_both_solves() {
     let Some(dir) = shared::shared_file("data/fbx") else { return };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "fbx"))
-        .collect();
-    files.sort();
+    let files = files_in(&dir, "fbx");
     assert_eq!(files.len(), 4, "{files:?}");
     for key in ["unitree_g1", "booster_t1_29dof"] {
         let model = shipped_model(key);

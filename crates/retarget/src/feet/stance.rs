@@ -32,26 +32,28 @@ impl RobotFoot {
     pub fn within_band(&self, rot: &UnitQuaternion<f64>, band: f64) -> UnitQuaternion<f64> {
         let flat = self.flat(self.yaw(rot));
         let tilt = flat.inverse() * rot;
-        let spread = |q: &UnitQuaternion<f64>| {
-            let z = self.corners.iter().map(|c| (q * c).z);
-            let (lo, hi) =
-                z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-            hi - lo
-        };
-        let rest = spread(&flat);
-        if self.corners.len() < 2 || spread(rot) - rest <= band {
+        let rest = self.height_spread(&flat);
+        if self.corners.len() < 2 || self.height_spread(rot) - rest <= band {
             return *rot;
         }
         let mut share = 1.0;
         for _ in 0..BAND_RESCALINGS {
             let at = flat * UnitQuaternion::identity().slerp(&tilt, share);
-            let over = spread(&at) - rest;
+            let over = self.height_spread(&at) - rest;
             if over <= band {
                 break;
             }
             share *= band / over;
         }
         flat * UnitQuaternion::identity().slerp(&tilt, share)
+    }
+
+    /// How far (m) the sole's highest bottom point stands above its lowest at orientation
+    /// `rot`.
+    fn height_spread(&self, rot: &UnitQuaternion<f64>) -> f64 {
+        let z = self.corners.iter().map(|c| (rot * c).z);
+        let (lo, hi) = z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        hi - lo
     }
 
     /// The sole's length (m): the spread of its bottom points along its forward direction.
@@ -262,11 +264,7 @@ mod tests {
         };
         let feet = [Some(foot.clone()), Some(RobotFoot { slot: 1, ..foot.clone() })];
         plan(&feet, &contacts, &mut targets, 2, fps, &options);
-        let spread = |p: &Pose| {
-            let z: Vec<f64> = foot.corners.iter().map(|c| (quat(p) * c).z).collect();
-            z.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-                - z.iter().copied().fold(f64::INFINITY, f64::min)
-        };
+        let spread = |p: &Pose| foot.height_spread(&quat(p));
         assert!(spread(&targets[10 * 2]) <= options.sole_band + 1e-9, "{}", spread(&targets[20]));
         // Deep in the double support: the human's 10°, its corners 3.5 cm apart in height.
         assert!(spread(&targets[45 * 2]) > 0.03, "{}", spread(&targets[90]));
@@ -298,11 +296,7 @@ mod tests {
         let heights = |p: &Pose| -> Vec<f64> {
             foot.corners.iter().map(|c| (quat(p) * c + p.pos).z).collect()
         };
-        let lift = |p: &Pose| {
-            let z = heights(p);
-            z.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-                - z.iter().copied().fold(f64::INFINITY, f64::min)
-        };
+        let lift = |p: &Pose| foot.height_spread(&quat(p));
         let toes: Vec<bool> = (0..frames).map(|t| t >= 30).collect();
         let on_toes = planned(Some([toes, vec![false; frames]]));
         let human = 0.2 * 40f64.to_radians().sin();

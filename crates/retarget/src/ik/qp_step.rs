@@ -35,18 +35,7 @@ impl Solver<'_> {
         if self.rows_made && self.moved.iter().all(|m| m.abs() <= RELINEARISE) {
             self.dense.shift_rows(&self.row_base, &self.moved);
         } else {
-            let ctx = StepContext {
-                model: self.model,
-                data: &self.data,
-                qpos: &self.qpos,
-                raised: &self.raised,
-            };
-            self.dense.clear_rows();
-            self.row_ends.clear();
-            for c in &mut self.constraints {
-                c.add_rows(&ctx, &mut self.dense);
-                self.row_ends.push(self.dense.num_rows());
-            }
+            self.make_rows();
             self.row_base.clear();
             self.row_base.extend_from_slice(self.dense.rhs());
             self.moved.fill(0.0);
@@ -56,6 +45,23 @@ impl Solver<'_> {
         let status = self.constrained_solve(&ends);
         self.row_ends = ends;
         status
+    }
+
+    /// Every constraint's rows at the current configuration into `self.dense` (cleared
+    /// first), and where each constraint's rows end in `self.row_ends`.
+    pub(super) fn make_rows(&mut self) {
+        let ctx = StepContext {
+            model: self.model,
+            data: &self.data,
+            qpos: &self.qpos,
+            raised: &self.raised,
+        };
+        self.dense.clear_rows();
+        self.row_ends.clear();
+        for c in &mut self.constraints {
+            c.add_rows(&ctx, &mut self.dense);
+            self.row_ends.push(self.dense.num_rows());
+        }
     }
 
     /// [`Solver::constrained_step`] once the rows are in `self.dense`.

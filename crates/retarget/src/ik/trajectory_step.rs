@@ -113,16 +113,7 @@ impl<'m> Solver<'m> {
     /// The constraints' rows `a · Δq ≥ b` at the current configuration (every constraint
     /// added with [`Solver::add_constraint`]), as `(a, b)` pairs.
     pub fn constraint_rows(&mut self) -> Vec<(&[f64], f64)> {
-        let ctx = StepContext {
-            model: self.model,
-            data: &self.data,
-            qpos: &self.qpos,
-            raised: &self.raised,
-        };
-        self.dense.clear_rows();
-        for c in &mut self.constraints {
-            c.add_rows(&ctx, &mut self.dense);
-        }
+        self.make_rows();
         self.rows_made = false;
         (0..self.dense.num_rows()).filter_map(|k| self.dense.row(k)).collect()
     }
