@@ -17,6 +17,8 @@
 //! the options' other settings).
 //!
 //! [`Planting::Off`]: crate::solve::Planting::Off
+//! [`PlausibleOptions`]: crate::PlausibleOptions
+//! [`PlausibleOptions::causal`]: crate::PlausibleOptions::causal
 
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
@@ -38,7 +40,7 @@ use crate::marker_config::MarkerConfig;
 use crate::motion::RobotMotion;
 use crate::report::{QualityReport, ReportOptions};
 use crate::solve::{
-    build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, PlausibleOptions,
+    build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, Pipeline,
     RetargetOptions, SolveMode,
 };
 use crate::targets::TargetMap;
@@ -266,7 +268,7 @@ impl Retargeter {
 
     /// The config a BVH clip is retargeted with, and why ([`crate::derive::choose`]).
     pub fn choose_config(&self, bvh: &Bvh) -> Result<Chosen, Error> {
-        let gmr = self.options.mode == SolveMode::Gmr;
+        let gmr = Pipeline::new(&self.options).is_gmr();
         crate::derive::choose(
             &self.model,
             &self.label,
@@ -329,7 +331,7 @@ impl Retargeter {
     /// The config an FBX take is retargeted with, and why: [`Retargeter::choose_config`] of
     /// its skeleton, with the file's axes and unit ([`FbxClip::fk_options`]).
     pub fn choose_fbx_config(&self, clip: &FbxClip) -> Result<Chosen, Error> {
-        let gmr = self.options.mode == SolveMode::Gmr;
+        let gmr = Pipeline::new(&self.options).is_gmr();
         let fk = clip.fk_options(&self.options.fk);
         let (given, tuned) = (self.given.clone(), self.tuned.as_ref());
         crate::derive::choose(&self.model, &self.label, &clip.bvh, &fk, given, tuned, gmr)
@@ -470,12 +472,11 @@ impl Retargeter {
                     )));
                 }
             };
-            let options = stream_options(&self.options);
             *slot = Some(Stream::new(
                 Arc::clone(&self.model),
                 config,
                 &frame.body_names,
-                options,
+                &self.options,
                 self.stream_fps,
             )?);
         }
@@ -574,22 +575,6 @@ pub struct FileResult {
     pub inferred: String,
 }
 
-/// The options a stream runs: GMR's as given, else the default mode's causal part.
-fn stream_options(options: &RetargetOptions) -> RetargetOptions {
-    let mut out = options.clone();
-    if let SolveMode::Plausible(p) = &options.mode {
-        let causal = PlausibleOptions::causal();
-        out.mode = SolveMode::Plausible(PlausibleOptions {
-            planting: causal.planting,
-            both_ways: causal.both_ways,
-            trajectory: causal.trajectory,
-            ..p.clone()
-        });
-    }
-    out.chunk = None;
-    out
-}
-
 self_cell::self_cell!(
     /// The stream's solver, borrowing the model it owns a handle of.
     struct StreamSolver {
@@ -613,7 +598,8 @@ struct Stream {
     positions: Vec<Vector3<f64>>,
     orientations: Vec<UnitQuaternion<f64>>,
     targets: Vec<Pose>,
-    options: RetargetOptions,
+    /// What runs: GMR's solve as given, else the default solve's causal part.
+    pipeline: Pipeline,
     dt: f64,
     frames: usize,
     last: Option<FrameDiagnostics>,
@@ -624,7 +610,7 @@ impl Stream {
         model: Arc<Model>,
         config: &IkConfig,
         names: &[String],
-        options: RetargetOptions,
+        options: &RetargetOptions,
         fps: f64,
     ) -> Result<Stream, Error> {
         if !(fps.is_finite() && fps > 0.0) {
@@ -636,7 +622,8 @@ impl Stream {
         config.validate(&model, names)?;
         let map = TargetMap::new(config, names, height)?;
         let stages = task_specs(config, &model, &map);
-        let solver = StreamSolver::try_new(model, |m| build_solver(m, &stages, &options))?;
+        let pipeline = Pipeline::new(options).causal();
+        let solver = StreamSolver::try_new(model, |m| build_solver(m, &stages, &pipeline))?;
         let tracked = solver.borrow_dependent().tracked().to_vec();
         let slots = map.bodies.len();
         Ok(Stream {
@@ -647,7 +634,7 @@ impl Stream {
             positions: Vec::new(),
             orientations: Vec::new(),
             targets: vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; slots],
-            options,
+            pipeline,
             dt: 1.0 / fps,
             frames: 0,
             last: None,
@@ -677,7 +664,7 @@ impl Stream {
             return Err(Error::NonFinite { frame: self.frames, message });
         }
         let first = self.frames == 0;
-        let plausible = matches!(self.options.mode, SolveMode::Plausible(_));
+        let plausible = !self.pipeline.is_gmr();
         let (targets, tracked, dt, index) = (&self.targets, &self.tracked, self.dt, self.frames);
         let diag = self.solver.with_dependent_mut(|model, solver| {
             let diag = if first && plausible {

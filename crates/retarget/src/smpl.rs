@@ -26,7 +26,7 @@ use crate::config::IkConfig;
 use crate::derive::{Choice, Chosen, HumanBody};
 use crate::motion::RobotMotion;
 use crate::robot_roles::RobotRoles;
-use crate::solve::{ClipDiagnostics, SolveMode};
+use crate::solve::ClipDiagnostics;
 use crate::{Error, Retargeter};
 
 /// The first frame `--gmr` retargets: GMR's `smplx_to_robot.py` starts at frame 1.
@@ -117,7 +117,7 @@ impl Retargeter {
             path: motion.source.display().to_string(),
             source: Box::new(e),
         };
-        let gmr = self.options().mode == SolveMode::Gmr;
+        let gmr = crate::solve::Pipeline::new(self.options()).is_gmr();
         let mut options = self.options().clone();
         let (human, height, source) = if gmr {
             let resampled = smpl::gmr::offline_fast(body, motion, smpl::conventions::GMR_FPS)

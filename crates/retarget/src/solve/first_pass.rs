@@ -16,7 +16,6 @@ use nalgebra::Vector3;
 
 use super::prepare::reject_divergence;
 use super::prepare::Prepared;
-use super::SolveMode;
 use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::Error;
@@ -45,7 +44,7 @@ impl<'a> Prepared<'a> {
                 }
                 Ok((qpos, out))
             };
-        if !matches!(&self.options.mode, SolveMode::Plausible(p) if p.both_ways) {
+        if !self.pipeline.both_ways {
             return forward(solver);
         }
         // The two directions on two threads of rayon's pool (one, in a busy pool, is the same
@@ -69,7 +68,7 @@ impl<'a> Prepared<'a> {
     ) -> Result<FrameDiagnostics, Error> {
         self.set_frame_tasks(solver, f)?;
         let targets = self.frame_targets(f);
-        let diagnostics = if first && matches!(self.options.mode, SolveMode::Plausible(_)) {
+        let diagnostics = if first && !self.pipeline.is_gmr() {
             solve_first_frame(self.model, solver, &self.tracked, targets)?
         } else {
             solver.solve_frame(targets, first_frame_dt(first, self.frame_dt()))?

@@ -11,35 +11,20 @@ use mjcf::Model;
 use nalgebra::Vector3;
 
 use super::prepare::Prepared;
-use super::{Planting, PlausibleOptions, SolveMode};
 use crate::feet::RobotFoot;
 use crate::ik::{PointTask, Solver, TaskSpec};
 use crate::Error;
 
 impl<'a> Prepared<'a> {
     /// The default solve's foot plan, when it plants the feet: the robot's feet found and
-    /// planted on the source's contacts.
+    /// planted on the source's contacts (when both the human's and the robot's feet are
+    /// found; otherwise the targets stay GMR's and only the constraints apply).
     pub(super) fn plan(&mut self) {
-        let SolveMode::Plausible(plausible) = &self.options.mode else { return };
-        if plausible.planting == Planting::On {
-            let feet = robot_feet(self.model, &self.stages);
-            self.plan_feet(plausible, feet);
-        }
-    }
-
-    /// Planted foot targets for the robot's `feet` from the source contacts (when both the
-    /// human's and the robot's feet are found; otherwise the targets stay GMR's and only the
-    /// constraints apply).
-    pub(super) fn plan_feet(&mut self, options: &PlausibleOptions, feet: [Option<RobotFoot>; 2]) {
+        let Some(options) = &self.pipeline.foot_plan else { return };
+        let feet = robot_feet(self.model, &self.stages);
         let Some(contacts) = &self.contacts else { return };
-        let plan = crate::feet::plan(
-            &feet,
-            contacts,
-            &mut self.targets,
-            self.slots,
-            self.fps,
-            &options.feet,
-        );
+        let plan =
+            crate::feet::plan(&feet, contacts, &mut self.targets, self.slots, self.fps, options);
         self.plan = Some((feet, plan));
     }
 

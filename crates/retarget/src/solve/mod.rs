@@ -13,9 +13,10 @@
 //!
 //! Stages 5 and 6 run over a schedule (`schedule.rs`): the whole clip, or chunks of it in
 //! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
-//! 2 and 5 with GMR's solver and nothing else. A stage with something to say about the clip
-//! pushes a [`StageReport`] (named after its file: `treadmill`, `reweigh`) onto
-//! [`ClipDiagnostics::stages`].
+//! 2 and 5 with GMR's solver and nothing else. The mode is read once, by [`Pipeline::new`]
+//! (`pipeline.rs`): which stages run and with what options, what the stages read. A stage
+//! with something to say about the clip pushes a [`StageReport`] (named after its file:
+//! `treadmill`, `reweigh`) onto [`ClipDiagnostics::stages`].
 
 pub(crate) mod banded;
 mod contacts;
@@ -23,6 +24,7 @@ pub mod dynamics_term;
 mod first_pass;
 mod footholds;
 mod options;
+mod pipeline;
 mod prepare;
 mod reweigh;
 mod schedule;
@@ -43,6 +45,7 @@ pub use options::{
     ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
     SpeedLimits, StageReport, StageValue,
 };
+pub(crate) use pipeline::Pipeline;
 pub(crate) use prepare::build_solver;
 pub use prepare::task_specs;
 pub(crate) use prepare::{finite_pose, reject_divergence};
@@ -89,11 +92,15 @@ pub fn retarget_motion(
     config: &IkConfig,
     options: &RetargetOptions,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    let pipeline = Pipeline::new(options);
     // 0. The floor: a source on a treadmill walked off it.
-    let walked = treadmill::walk_off(human, options);
+    let walked = pipeline
+        .treadmill
+        .then(|| treadmill::walk_off(human, options, &pipeline.contacts))
+        .flatten();
     let human = walked.as_ref().map_or(human, |(walked, _)| walked);
     // 1. The targets.
-    let mut prepared = Prepared::new(human, model, config, options)?;
+    let mut prepared = Prepared::new(human, model, config, options, &pipeline)?;
     prepared.reports.extend(walked.as_ref().map(|(_, report)| report.clone()));
     // 2. The source's contacts.
     prepared.detect_contacts(human);
@@ -133,10 +140,7 @@ pub(crate) fn solve_range(
 ) -> Result<Solved, Error> {
     let nq = prepared.model.nq;
     let first = range.start.saturating_sub(lead_in);
-    let trajectory = match &prepared.options.mode {
-        SolveMode::Plausible(p) if p.trajectory.iterations > 0 => Some(&p.trajectory),
-        _ => None,
-    };
+    let trajectory = prepared.pipeline.trajectory.as_ref();
     let ahead = trajectory.map_or(0, |t| trajectory::overlap_frames(t, prepared.fps));
     let end = (range.end + ahead).min(prepared.num_frames());
     let mut solver = prepared.solver()?;

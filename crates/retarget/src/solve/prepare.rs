@@ -10,9 +10,8 @@
 use mjcf::{JointType, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::{
-    ClipDiagnostics, RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits, StageReport,
-};
+use super::pipeline::Pipeline;
+use super::{ClipDiagnostics, RetargetOptions, SelfCollisionMode, SpeedLimits, StageReport};
 use crate::config::IkConfig;
 use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
@@ -30,6 +29,8 @@ pub(crate) struct Prepared<'a> {
     // (The stages' files read and write these fields.)
     pub(super) model: &'a Model,
     pub(super) options: &'a RetargetOptions,
+    /// The stages that run, and their options.
+    pub(super) pipeline: &'a Pipeline,
     pub(super) stages: Vec<Vec<TaskSpec>>,
     /// `(body, target slot)` of each tracked body, as [`Solver::tracked`] orders them.
     pub(super) tracked: Vec<(usize, usize)>,
@@ -60,6 +61,7 @@ impl<'a> Prepared<'a> {
         model: &'a Model,
         config: &IkConfig,
         options: &'a RetargetOptions,
+        pipeline: &'a Pipeline,
     ) -> Result<Prepared<'a>, Error> {
         human.validate()?;
         let height = options
@@ -86,6 +88,7 @@ impl<'a> Prepared<'a> {
         let prepared = Prepared {
             model,
             options,
+            pipeline,
             stages,
             tracked,
             slots,
@@ -105,16 +108,15 @@ impl<'a> Prepared<'a> {
         self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
     }
 
+    /// The contact points' weight ([`crate::FootPlanOptions::contact_weight`]; 0 without a
+    /// foot plan).
     pub(super) fn contact_weight(&self) -> f64 {
-        match &self.options.mode {
-            SolveMode::Plausible(p) => p.feet.contact_weight,
-            SolveMode::Gmr => 0.0,
-        }
+        self.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.contact_weight)
     }
 
     /// A solver for this clip: GMR's, or with the default mode's constraints.
     pub(super) fn solver(&self) -> Result<Solver<'a>, Error> {
-        build_solver(self.model, &self.stages, self.options)
+        build_solver(self.model, &self.stages, self.pipeline)
     }
 
     /// Seconds between frames (0 for a clip without a rate).
@@ -224,15 +226,10 @@ impl crate::solve::trajectory::Frames for Prepared<'_> {
 pub(crate) fn build_solver<'m>(
     model: &'m Model,
     stages: &[Vec<TaskSpec>],
-    options: &RetargetOptions,
+    pipeline: &Pipeline,
 ) -> Result<Solver<'m>, Error> {
-    let mut solver_options = options.solver.clone();
-    if let SolveMode::Plausible(p) = &options.mode {
-        solver_options.max_extra_steps = p.max_extra_steps;
-        solver_options.arithmetic = crate::ik::Arithmetic::Lean;
-    }
-    let mut solver = Solver::new(model, stages, solver_options)?;
-    if let SolveMode::Plausible(p) = &options.mode {
+    let mut solver = Solver::new(model, stages, pipeline.solver.clone())?;
+    if let Some(p) = &pipeline.constraints {
         solver.add_constraint(Box::new(Ground::new(model, p.floor)));
         if p.self_collision == SelfCollisionMode::On {
             solver.add_constraint(Box::new(SelfCollision::new(model)));

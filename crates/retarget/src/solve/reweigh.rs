@@ -14,7 +14,7 @@ use std::ops::Range;
 use mjcf::Model;
 
 use super::prepare::Prepared;
-use super::{PlausibleOptions, SolveMode, StageReport, StageValue};
+use super::{PlausibleOptions, StageReport, StageValue};
 use crate::ik::TaskSpec;
 use crate::Error;
 
@@ -23,14 +23,14 @@ impl<'a> Prepared<'a> {
     /// ([`Prepared::pelvis_offset`], [`PlausibleOptions::pelvis_offset_range`]).
     /// Stage 4 (default solve, feet planted).
     pub(super) fn reweigh_where_planted(&mut self) -> Result<(), Error> {
-        let SolveMode::Plausible(plausible) = &self.options.mode else { return Ok(()) };
+        let Some(options) = self.pipeline.reweigh else { return Ok(()) };
         if self.plan.is_none() {
             return Ok(());
         }
-        self.reweigh(&plausible.clone())
+        self.reweigh(&options)
     }
 
-    fn reweigh(&mut self, options: &PlausibleOptions) -> Result<(), Error> {
+    fn reweigh(&mut self, options: &ReweighOptions) -> Result<(), Error> {
         // Only a root position weight above the cap holds the pelvis where the legs cannot
         // follow (GMR's G1 and H1 configs, 100; its T1, PM01 and ToddlerBot configs weigh it
         // 10, and doubling their trunk's and legs' rotation weights alone cost the PM01's
@@ -114,6 +114,24 @@ fn report(offset: f64, share: f64) -> StageReport {
     }
 }
 
+/// Stage 4's tunables, [`PlausibleOptions`]' (documented there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ReweighOptions {
+    pub trunk_rotation_scale: f64,
+    pub root_position_weight_cap: f64,
+    pub pelvis_offset_range: [f64; 2],
+}
+
+impl From<&PlausibleOptions> for ReweighOptions {
+    fn from(p: &PlausibleOptions) -> ReweighOptions {
+        ReweighOptions {
+            trunk_rotation_scale: p.trunk_rotation_scale,
+            root_position_weight_cap: p.root_position_weight_cap,
+            pelvis_offset_range: p.pelvis_offset_range,
+        }
+    }
+}
+
 /// Windows of a clip solved to measure how far the pelvis stands from its target
 /// ([`Prepared::pelvis_offset`]), their length (s), and the time at the start of each left
 /// out (s; the solve settles from its start pose). 30 and 5 frames at 30 fps.
@@ -126,7 +144,7 @@ const PELVIS_SETTLE_S: f64 = 1.0 / 6.0;
 /// the config's, with the rotation weight of every task whose body is not on an arm
 /// multiplied by [`PlausibleOptions::trunk_rotation_scale`], and the position weight of the
 /// root's task (the task whose target is the human root, slot `root_target`) at most
-/// [`PlausibleOptions::root_position_weight_cap`]; `share` (0 to 1) of each change. The arms
+/// [`PlausibleOptions::root_position_weight_cap`] (`options`: those two); `share` (0 to 1) of each change. The arms
 /// are the subtrees that hang from the recognised chest towards each upper arm
 /// ([`crate::RobotRoles`]); a robot the recogniser rejects keeps its rotation weights.
 ///
@@ -135,11 +153,11 @@ const PELVIS_SETTLE_S: f64 = 1.0 / 6.0;
 /// 1.24× → 1.09× (the per-frame solve with its smoothing filter). On configs whose targets agree with
 /// the robot's legs it trades position for little rotation (every share 1, our derived
 /// config, the G1 on the Bandai walk: 4.29° → 4.04°, 1.55 → 2.97 cm), hence the share.
-pub fn reweigh(
+pub(crate) fn reweigh(
     stages: &mut [Vec<TaskSpec>],
     model: &Model,
     root_target: usize,
-    options: &PlausibleOptions,
+    options: &ReweighOptions,
     share: f64,
 ) {
     if share <= 0.0 {

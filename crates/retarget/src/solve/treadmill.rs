@@ -9,17 +9,18 @@ use std::collections::BTreeMap;
 
 use fk::HumanMotion;
 
-use super::{RetargetOptions, SolveMode, StageReport, StageValue};
-use crate::contact_phases::{human_foot_points, off_treadmill, treadmill};
+use super::{RetargetOptions, StageReport, StageValue};
+use crate::contact_phases::{human_foot_points, off_treadmill, treadmill, ContactOptions};
 
-/// `human` off its treadmill, and what was done, where it is on one (default solve only).
+/// `human` off its treadmill, and what was done, where it is on one (its feet found by the
+/// roles of `options.fk`, its contacts with `contact`).
 pub(super) fn walk_off(
     human: &HumanMotion,
     options: &RetargetOptions,
+    contact: &ContactOptions,
 ) -> Option<(HumanMotion, StageReport)> {
-    let SolveMode::Plausible(plausible) = &options.mode else { return None };
     let feet = human_foot_points(&human.body_names, &options.fk.roles)?;
-    let belt = treadmill(human, feet, 0, &plausible.contact)?;
+    let belt = treadmill(human, feet, 0, contact)?;
     let report = StageReport {
         stage: "treadmill",
         summary: format!(
