@@ -52,6 +52,8 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
+    /// An option, argument or call that does not fit (the robot, the model, the clip or the
+    /// state of a stream); the message says which and why.
     #[error("invalid option: {0}")]
     InvalidOption(String),
     /// Human forward kinematics failed (bad BVH content, NaN in the motion, ...).
@@ -89,9 +91,11 @@ pub enum Error {
     /// ([`crate::RobotRoles`]).
     #[error("robot `{model}` is not a two-armed biped: {reason}")]
     NotHumanoid { model: String, reason: String },
-    /// Non-finite target or solver state at a frame.
+    /// The solve failed numerically at `frame`: a target not finite, a solve that diverged
+    /// there, a trajectory window starting there whose quadratic model is not positive
+    /// definite; `message` says which.
     #[error("frame {frame}: {message}")]
-    NonFinite { frame: usize, message: String },
+    Numerical { frame: usize, message: String },
     /// A motion handed to a writer with a non-finite `qpos` entry.
     #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
     NonFiniteQpos { frame: usize, index: usize, value: f64 },
@@ -103,9 +107,13 @@ pub enum Error {
     /// An `.npz` (or other motion file) whose content is not what we write.
     #[error("{}: {message}", path.display())]
     Read { path: PathBuf, message: String },
-    /// A report or writer option that does not fit the model.
-    #[error("{0}")]
-    Options(String),
+}
+
+impl Error {
+    /// [`Error::Numerical`] at `frame`.
+    pub(crate) fn numerical(frame: usize, message: String) -> Error {
+        Error::Numerical { frame, message }
+    }
 }
 
 fn did_you_mean(nearest: &[String]) -> String {

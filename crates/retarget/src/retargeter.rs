@@ -661,7 +661,7 @@ impl Stream {
         if let Some(bad) = self.targets.iter().position(|p| !finite_pose(p)) {
             let name = self.map.bodies.get(bad).map_or("?", |b| b.name.as_str());
             let message = format!("target of human body `{name}` is not finite");
-            return Err(Error::NonFinite { frame: self.frames, message });
+            return Err(Error::Numerical { frame: self.frames, message });
         }
         let first = self.frames == 0;
         let plausible = !self.pipeline.is_gmr();

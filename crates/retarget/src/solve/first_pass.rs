@@ -293,7 +293,7 @@ fn splice_passes(
 
 #[cfg(test)]
 mod tests {
-    use super::super::prepare::diverged;
+    use super::super::prepare::{diverged, reject_divergence};
     use super::splice_passes;
     use crate::ik::FrameDiagnostics;
 
@@ -362,5 +362,9 @@ mod tests {
         q[0] = 0.0;
         q[8] = f64::NAN;
         assert!(diverged(&q));
+        // A numerical failure, not an option: which frame, and what.
+        let err = reject_divergence(&q, 7).unwrap_err();
+        assert!(matches!(err, crate::Error::Numerical { frame: 7, .. }), "{err:?}");
+        assert_eq!(err.to_string(), "frame 7: the solver diverged");
     }
 }

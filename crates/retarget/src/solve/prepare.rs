@@ -82,7 +82,7 @@ impl<'a> Prepared<'a> {
             if let Some(bad) = out.iter().position(|p| !finite_pose(p)) {
                 let message =
                     format!("target of human body `{}` is not finite", map.bodies[bad].name);
-                return Err(Error::NonFinite { frame: f, message });
+                return Err(Error::Numerical { frame: f, message });
             }
         }
         let prepared = Prepared {
@@ -272,10 +272,10 @@ pub(super) fn diverged(qpos: &[f64]) -> bool {
     qpos.iter().any(|v| !v.is_finite() || v.abs() > fk::MAX_DISTANCE)
 }
 
-/// [`Error::NonFinite`] naming `frame` when its solved `qpos` [diverged].
+/// [`Error::Numerical`] naming `frame` when its solved `qpos` [diverged].
 pub(crate) fn reject_divergence(qpos: &[f64], frame: usize) -> Result<(), Error> {
     if diverged(qpos) {
-        return Err(Error::NonFinite { frame, message: "the solver diverged".to_owned() });
+        return Err(Error::Numerical { frame, message: "the solver diverged".to_owned() });
     }
     Ok(())
 }

@@ -364,7 +364,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         self.speed_terms(seq);
         self.dynamics_terms(seq.fixed.len());
         if self.banded.factor().is_err() {
-            return Err(Error::InvalidOption(
+            return Err(Error::numerical(
+                first,
                 "the trajectory's quadratic model is not positive definite".to_owned(),
             ));
         }
