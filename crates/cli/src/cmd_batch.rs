@@ -325,11 +325,10 @@ impl Job {
         let file = c3d::C3d::from_path(src).with_context(|| format!("{}", src.display()))?;
         let name = src.display().to_string();
         let clip = markers.motion(&file, &name, self.retargeter.options().human_height)?;
-        let (motion, mut diag) = self
+        let (motion, diag) = self
             .retargeter
             .retarget_with(&clip.human, &config, clip.height)
             .with_context(|| format!("{}: retargeting", src.display()))?;
-        diag.human_height_source = clip.height_source;
         Ok((motion, diag, config))
     }
 }

@@ -147,11 +147,9 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         let markers = MarkerConfig::from_file(config_path)?;
         let file = c3d::C3d::from_path(&input).with_context(|| format!("{}", input.display()))?;
         let clip = markers.motion(&file, &input.display().to_string(), args.human_height)?;
-        let (motion, mut diag) = retargeter
+        retargeter
             .retarget_with(&clip.human, &config, clip.height)
-            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?;
-        diag.human_height_source = clip.height_source;
-        (motion, diag)
+            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
     } else {
         if let Some(path) = &args.config {
             retargeter = retargeter.with_config(IkConfig::from_file(path)?);

@@ -130,7 +130,7 @@ pub use ik::{Arithmetic, SolverOptions};
 pub use solve::trajectory::Objective;
 pub use solve::{
     ChunkOptions, DynamicsOptions, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode,
-    SolveMode, SpeedLimits, TrajectoryOptions,
+    SolveMode, SpeedLimits, SubjectHeight, TrajectoryOptions,
 };
 
 // The inputs besides the human motion: IK and marker configs, FBX clips, robot roles.

@@ -15,6 +15,7 @@ use fk::markers::MarkerBody;
 use fk::HumanMotion;
 use serde_json::Value;
 
+use crate::solve::SubjectHeight;
 use crate::Error;
 
 /// The marker part of a marker-driven IK config.
@@ -47,10 +48,9 @@ pub struct MarkerHeight {
 #[derive(Debug, Clone, PartialEq)]
 pub struct MarkerMotion {
     pub human: HumanMotion,
-    /// Metres.
-    pub height: f64,
-    /// Where the height came from (`given`, `config subject_height_m`, `markers ...`).
-    pub height_source: String,
+    /// The subject height and where it came from (`given`, `config subject_height_m`,
+    /// `markers ...`).
+    pub height: SubjectHeight,
 }
 
 impl MarkerConfig {
@@ -153,10 +153,10 @@ impl MarkerConfig {
             &self.bodies,
         )
         .map_err(|e| marker_error("marker bodies", e))?;
-        let (height, height_source) = if let Some(h) = human_height {
-            (h, "given".to_owned())
+        let height = if let Some(h) = human_height {
+            SubjectHeight::given(h)
         } else if let Some(h) = self.subject_height {
-            (h, "config subject_height_m".to_owned())
+            SubjectHeight { metres: h, source: "config subject_height_m".to_owned() }
         } else if let Some(m) = &self.height {
             let above = fk::markers::marker_height(
                 &labels,
@@ -169,18 +169,20 @@ impl MarkerConfig {
             .map_err(|e| marker_error("subject height", e))?
             .ok_or_else(|| Error::InvalidOption(format!("{name}: height markers never seen")))?;
             let fraction = m.fraction_of_stature;
-            (above / fraction, format!("markers {} at {fraction} of stature", m.top.join("+")))
+            let source = format!("markers {} at {fraction} of stature", m.top.join("+"));
+            SubjectHeight { metres: above / fraction, source }
         } else {
             return Err(Error::InvalidOption(format!(
                 "{name}: give the subject height (the config has no `marker_height`)"
             )));
         };
-        if !(height.is_finite() && height > 0.0) {
+        if !(height.metres.is_finite() && height.metres > 0.0) {
             return Err(Error::InvalidOption(format!(
-                "{name}: subject height {height} m is not positive"
+                "{name}: subject height {} m is not positive",
+                height.metres
             )));
         }
-        Ok(MarkerMotion { human, height, height_source })
+        Ok(MarkerMotion { human, height })
     }
 }
 

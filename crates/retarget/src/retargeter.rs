@@ -41,7 +41,7 @@ use crate::motion::RobotMotion;
 use crate::report::{QualityReport, ReportOptions};
 use crate::solve::{
     build_solver, finite_pose, solve_first_frame, task_specs, ClipDiagnostics, Pipeline,
-    RetargetOptions, SolveMode,
+    RetargetOptions, SolveMode, SubjectHeight,
 };
 use crate::targets::TargetMap;
 use crate::writers::Format;
@@ -377,8 +377,11 @@ impl Retargeter {
     /// options' or the config's `human_height_assumption` (GMR without `actual_human_height`).
     pub fn retarget(&self, human: &HumanMotion) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let config = self.motion_config()?;
-        let height = self.options.human_height.unwrap_or(config.human_height_assumption);
-        self.retarget_with(human, config, height)
+        self.retarget_with(
+            human,
+            config,
+            SubjectHeight::of_motion(self.options.human_height, config),
+        )
     }
 
     /// Retargets a C3D clip through the virtual marker bodies of `markers` with `config` (the
@@ -391,9 +394,7 @@ impl Retargeter {
         config: &IkConfig,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let clip = markers.motion(file, name, self.options.human_height)?;
-        let (motion, mut diag) = self.retarget_with(&clip.human, config, clip.height)?;
-        diag.human_height_source = clip.height_source;
-        Ok((motion, diag))
+        self.retarget_with(&clip.human, config, clip.height)
     }
 
     /// [`Retargeter::retarget_c3d`] of the C3D file at `path` with the marker-driven IK config
@@ -412,21 +413,16 @@ impl Retargeter {
         self.retarget_c3d(&file, &name, &markers, &ik)
     }
 
-    /// Retargets a human motion with `config` and the subject height `height` (metres),
-    /// serially or in chunks ([`RetargetOptions::chunk`]).
+    /// Retargets a human motion with `config` and the subject height `height` (the one the
+    /// clip's source decided; [`SubjectHeight::given`] for a number), serially or in chunks
+    /// ([`RetargetOptions::chunk`]).
     pub fn retarget_with(
         &self,
         human: &HumanMotion,
         config: &IkConfig,
-        height: f64,
+        height: SubjectHeight,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-        let options = RetargetOptions { human_height: Some(height), ..self.options.clone() };
-        match options.chunk {
-            Some(chunk) => {
-                crate::solve::retarget_motion_chunked(human, &self.model, config, &options, chunk)
-            }
-            None => crate::solve::retarget_motion(human, &self.model, config, &options),
-        }
+        crate::solve::solve_clip(human, &self.model, config, &self.options, &height)
     }
 
     /// Writes a motion of this robot (format from the extension, or `format`), atomically.
@@ -618,9 +614,9 @@ impl Stream {
                 "stream fps {fps}: expected a positive rate"
             )));
         }
-        let height = options.human_height.unwrap_or(config.human_height_assumption);
+        let height = SubjectHeight::of_motion(options.human_height, config);
         config.validate(&model, names)?;
-        let map = TargetMap::new(config, names, height)?;
+        let map = TargetMap::new(config, names, height.metres)?;
         let stages = task_specs(config, &model, &map);
         let pipeline = Pipeline::new(options).causal();
         let solver = StreamSolver::try_new(model, |m| build_solver(m, &stages, &pipeline))?;

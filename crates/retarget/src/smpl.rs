@@ -26,7 +26,7 @@ use crate::config::IkConfig;
 use crate::derive::{Choice, Chosen, HumanBody};
 use crate::motion::RobotMotion;
 use crate::robot_roles::RobotRoles;
-use crate::solve::ClipDiagnostics;
+use crate::solve::{ClipDiagnostics, SubjectHeight};
 use crate::{Error, Retargeter};
 
 /// The first frame `--gmr` retargets: GMR's `smplx_to_robot.py` starts at frame 1.
@@ -119,15 +119,17 @@ impl Retargeter {
         };
         let gmr = crate::solve::Pipeline::new(self.options()).is_gmr();
         let mut options = self.options().clone();
-        let (human, height, source) = if gmr {
+        let (human, height) = if gmr {
             let resampled = smpl::gmr::offline_fast(body, motion, smpl::conventions::GMR_FPS)
                 .map_err(|e| in_file(e.into()))?;
             let human = frames_from(&resampled, GMR_FIRST_FRAME);
-            let height = smpl::conventions::gmr_height(&motion.betas);
-            (human, height, "GMR's 1.66 + 0.1 · betas[0]".to_owned())
+            let metres = smpl::conventions::gmr_height(&motion.betas);
+            (human, SubjectHeight { metres, source: "GMR's 1.66 + 0.1 · betas[0]".to_owned() })
         } else {
-            (clip.human.clone(), clip.height, clip.height_source.clone())
+            let source = clip.height_source.clone();
+            (clip.human.clone(), SubjectHeight { metres: clip.height, source })
         };
+        let height = options.human_height.map_or(height, SubjectHeight::given);
         // The source's feet for the contact phases (both modes write them), by role.
         for (role, joint) in clip.roles() {
             options.fk.roles.entry(role).or_insert(joint);
@@ -137,23 +139,9 @@ impl Retargeter {
                 "too few frames to retarget (GMR's path skips the first resampled frame)".into(),
             )));
         }
-        let (height, source) = match options.human_height {
-            Some(h) => (h, "given".to_owned()),
-            None => (height, source),
-        };
-        options.human_height = Some(height);
-        let (robot, mut diag) = match options.chunk {
-            Some(chunk) => crate::solve::retarget_motion_chunked(
-                &human,
-                self.model(),
-                &chosen.config,
-                &options,
-                chunk,
-            ),
-            None => crate::solve::retarget_motion(&human, self.model(), &chosen.config, &options),
-        }
-        .map_err(in_file)?;
-        diag.human_height_source = source;
+        let (robot, mut diag) =
+            crate::solve::solve_clip(&human, self.model(), &chosen.config, &options, &height)
+                .map_err(in_file)?;
         diag.human_inferred = format!(
             "{} body model ({} joints), Z up, metres, {} fps; {}",
             body.kind,

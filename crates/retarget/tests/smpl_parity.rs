@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use fk::HumanMotion;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use npz::Npz;
-use retarget::{IkConfig, Retargeter, SolveMode};
+use retarget::{IkConfig, Retargeter, SolveMode, SubjectHeight};
 
 /// Largest |qpos − GMR's| allowed (rad, m), the float32 rounding of GMR's human data.
 const TOLERANCE: f64 = 1e-5;
@@ -136,7 +136,8 @@ fn gmr_smplx_path_matches_gmr_on_g1_and_t1() {
         // The solve alone, on GMR's own human data.
         let (_, height) = floats(&out, "human_height");
         let human = gmr_human(&out, rows);
-        let (solved, _) = retargeter.retarget_with(&human, &config, height[0]).unwrap();
+        let (solved, _) =
+            retargeter.retarget_with(&human, &config, SubjectHeight::given(height[0])).unwrap();
         let (solve_dq, _) = max_abs(&solved.qpos, gmr_q);
 
         // The whole path from the motion file.
@@ -148,7 +149,8 @@ fn gmr_smplx_path_matches_gmr_on_g1_and_t1() {
         let resampled = smpl::gmr::offline_fast(&body, &motion, 30.0).unwrap();
         let human = prefix(&retarget::internals::frames_from(&resampled, 1), rows);
         let height = smpl::conventions::gmr_height(&motion.betas);
-        let (ours, diag) = retargeter.retarget_with(&human, &config, height).unwrap();
+        let (ours, diag) =
+            retargeter.retarget_with(&human, &config, SubjectHeight::given(height)).unwrap();
         if run.motion == "walk" && run.robot == "unitree_g1" {
             // The entry point users call gives the same numbers.
             let (direct, _) = retargeter.retarget_smpl(&motion, &body).unwrap();

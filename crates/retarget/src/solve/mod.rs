@@ -43,7 +43,7 @@ pub use dynamics_term::DynamicsOptions;
 pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
     ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
-    SpeedLimits, StageReport, StageValue,
+    SpeedLimits, StageReport, StageValue, SubjectHeight,
 };
 pub(crate) use pipeline::Pipeline;
 pub(crate) use prepare::build_solver;
@@ -69,28 +69,42 @@ pub fn retarget_bvh(
         fk_options.height = options.human_height;
     }
     let (human, report) = fk::human_motion(bvh, &fk_options)?;
+    let height = SubjectHeight { metres: report.height, source: report.height_source.clone() };
     let mut opts = options.clone();
-    opts.human_height = Some(report.height);
     // The recognised roles, so that the source's feet are found whatever their names.
     if let Ok(humanoid) = &report.humanoid {
         for (role, joint) in humanoid.roles.iter() {
             opts.fk.roles.entry(role).or_insert_with(|| joint.name.clone());
         }
     }
-    let (motion, mut diag) = retarget_motion(&human, model, config, &opts)?;
+    let (motion, mut diag) = solve_clip(&human, model, config, &opts, &height)?;
     diag.human_inferred = report.inferred();
-    diag.human_height_source = report.height_source;
     Ok((motion, diag))
 }
 
-/// Retargets a human motion (world poses, metres, Z up) onto `model`: the stages in order.
-/// The subject height is `options.human_height` (required here: the FK report has it for
-/// BVH input).
+/// The stages (`solve_clip`) with the subject height given in `options.human_height`
+/// (required here).
 pub fn retarget_motion(
     human: &HumanMotion,
     model: &Model,
     config: &IkConfig,
     options: &RetargetOptions,
+) -> Result<(RobotMotion, ClipDiagnostics), Error> {
+    let metres = options
+        .human_height
+        .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
+    solve_clip(human, model, config, options, &SubjectHeight::given(metres))
+}
+
+/// Retargets a human motion (world poses, metres, Z up) of a subject `height` tall onto
+/// `model`: the stages in order (`options.human_height` is not read: `height` is the one
+/// decided for the clip).
+pub(crate) fn solve_clip(
+    human: &HumanMotion,
+    model: &Model,
+    config: &IkConfig,
+    options: &RetargetOptions,
+    height: &SubjectHeight,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
     let pipeline = Pipeline::new(options);
     // 0. The floor: a source on a treadmill walked off it.
@@ -100,7 +114,7 @@ pub fn retarget_motion(
         .flatten();
     let human = walked.as_ref().map_or(human, |(walked, _)| walked);
     // 1. The targets.
-    let mut prepared = Prepared::new(human, model, config, options, &pipeline)?;
+    let mut prepared = Prepared::new(human, model, config, options, &pipeline, height)?;
     prepared.reports.extend(walked.as_ref().map(|(_, report)| report.clone()));
     // 2. The source's contacts.
     prepared.detect_contacts(human);

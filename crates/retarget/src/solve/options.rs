@@ -172,6 +172,36 @@ impl RetargetOptions {
     }
 }
 
+/// The subject height the targets are scaled by (GMR's `actual_human_height`) and where it
+/// came from: decided once per clip, by its source (given in the options, FK's estimate, the
+/// markers, the body model, the config's assumption), and reported in [`ClipDiagnostics`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SubjectHeight {
+    pub metres: f64,
+    /// Where it came from, for people (`given`, `config subject_height_m`, how FK measured it).
+    pub source: String,
+}
+
+impl SubjectHeight {
+    /// A height given by the caller ([`RetargetOptions::human_height`]).
+    #[must_use]
+    pub fn given(metres: f64) -> SubjectHeight {
+        SubjectHeight { metres, source: "given".to_owned() }
+    }
+
+    /// The height of a motion or a stream: the one given, else the config's
+    /// `human_height_assumption` (GMR without `actual_human_height`).
+    pub(crate) fn of_motion(given: Option<f64>, config: &crate::config::IkConfig) -> SubjectHeight {
+        given.map_or_else(
+            || SubjectHeight {
+                metres: config.human_height_assumption,
+                source: "the config's human_height_assumption".to_owned(),
+            },
+            SubjectHeight::given,
+        )
+    }
+}
+
 /// Per-clip diagnostics: per frame, and which bodies the per-body arrays refer to.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ClipDiagnostics {

@@ -11,7 +11,9 @@ use mjcf::{JointType, Model};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::pipeline::Pipeline;
-use super::{ClipDiagnostics, RetargetOptions, SelfCollisionMode, SpeedLimits, StageReport};
+use super::{
+    ClipDiagnostics, RetargetOptions, SelfCollisionMode, SpeedLimits, StageReport, SubjectHeight,
+};
 use crate::config::IkConfig;
 use crate::constraints::{Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
@@ -41,7 +43,7 @@ pub(crate) struct Prepared<'a> {
     /// Foot bodies and per-frame weight factors (default mode).
     pub(super) plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
     pub(super) fps: f64,
-    pub(super) height: f64,
+    pub(super) height: &'a SubjectHeight,
     /// Target slot of the human root.
     pub(super) root_target: usize,
     /// What the stages that ran have to say, in order ([`ClipDiagnostics::stages`]): each
@@ -62,13 +64,11 @@ impl<'a> Prepared<'a> {
         config: &IkConfig,
         options: &'a RetargetOptions,
         pipeline: &'a Pipeline,
+        height: &'a SubjectHeight,
     ) -> Result<Prepared<'a>, Error> {
         human.validate()?;
-        let height = options
-            .human_height
-            .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
         config.validate(model, &human.body_names)?;
-        let map = TargetMap::new(config, &human.body_names, height)?;
+        let map = TargetMap::new(config, &human.body_names, height.metres)?;
         let stages = task_specs(config, model, &map);
         let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
         let (nb, nf) = (human.num_bodies(), human.num_frames);
@@ -190,8 +190,8 @@ impl<'a> Prepared<'a> {
                 .map(|&(b, _)| weighted(b, |t| t.rot_weight))
                 .collect(),
             frames,
-            human_height: self.height,
-            human_height_source: "given".to_owned(),
+            human_height: self.height.metres,
+            human_height_source: self.height.source.clone(),
             human_inferred: String::new(),
             solve_seconds,
             stages: self.reports.clone(),
