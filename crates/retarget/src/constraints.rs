@@ -28,6 +28,8 @@ pub struct StepContext<'a> {
     /// Geoms held higher than the floor in this frame, with the height each keeps above it
     /// (a swing foot's sole, [`crate::ik::Solver::set_raised_geoms`]), sorted by geom.
     pub raised: &'a [(usize, f64)],
+    /// Planted sole points and where this step may put them ([`Grip`]).
+    pub grips: &'a [GripBox],
 }
 
 /// A hard constraint of the IK step.
@@ -295,6 +297,49 @@ impl Constraint for SelfCollision {
     }
 }
 
+/// A planted sole's point (`point`, body `body`'s frame) in one step: where the step may put it
+/// horizontally, `lo ..= hi` in x and y (world, m), and how far (`half_width`, m) a step may
+/// be asked to bring it back where it is outside. [`crate::ik::Solver`] makes these from the
+/// foot plan's footholds ([`crate::ik::Solver::set_grips`]) and the previous frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GripBox {
+    pub body: usize,
+    pub point: Vector3<f64>,
+    pub lo: nalgebra::Vector2<f64>,
+    pub hi: nalgebra::Vector2<f64>,
+    pub half_width: f64,
+}
+
+/// A planted foot does not slide: each of the step's [`GripBox`]es holds its point within
+/// its box, four rows `±(p + J Δq) ≥ …` in x and y; a point outside its box comes back
+/// towards it by at most the half width in a step (asked to come back whole in one step,
+/// Talos's root jumped metres in a frame on CMU 131_01's toe spin). Added last, so that
+/// where a frame cannot hold it with the floor, the robot's geoms apart and the speed
+/// limits, it is the one dropped for that step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Grip;
+
+impl Constraint for Grip {
+    fn name(&self) -> &'static str {
+        "grip"
+    }
+
+    fn add_rows(&mut self, ctx: &StepContext<'_>, qp: &mut DenseQp) {
+        for g in ctx.grips {
+            let p = ctx.data.xpos[g.body] + ctx.data.xquat[g.body] * g.point;
+            for axis in 0..2 {
+                // p + J Δq ≥ lo, and −(p + J Δq) ≥ −hi, each asking at most the half width.
+                for (sign, b) in [(1.0, g.lo[axis] - p[axis]), (-1.0, p[axis] - g.hi[axis])] {
+                    let row = qp.add_row(b.min(g.half_width));
+                    for (d, column) in ctx.model.jac_point_columns(ctx.data, g.body, p) {
+                        row[d] = sign * column[axis];
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The world point of geom `g` with the smallest z (a support point in −z).
 #[must_use]
 pub fn lowest_point(model: &Model, data: &Data, g: usize) -> Vector3<f64> {
@@ -367,7 +412,7 @@ mod tests {
         let mut data = Data::new(m);
         m.kinematics(q, &mut data);
         let mut qp = DenseQp::new(m.nv);
-        let ctx = StepContext { model: m, data: &data, qpos: q, raised: &[] };
+        let ctx = StepContext { model: m, data: &data, qpos: q, raised: &[], grips: &[] };
         SelfCollision::new(m).add_rows(&ctx, &mut qp);
         (data, qp)
     }

@@ -157,9 +157,9 @@ pub use error::Error;
 /// change at any time.
 #[doc(hidden)]
 pub mod internals {
-    pub use crate::constraints::{Constraint, Ground, SelfCollision, StepContext};
+    pub use crate::constraints::{Constraint, Grip, GripBox, Ground, SelfCollision, StepContext};
     pub use crate::feet::detect_feet;
-    pub use crate::ik::{PointTask, Solver, TaskSpec};
+    pub use crate::ik::{GripPoint, PointTask, Solver, TaskSpec};
     pub use crate::joint_speed::JointSpeedLimits;
     pub use crate::lie::{mat_to_quat, Pose};
     pub use crate::marker_config::labelled_points;

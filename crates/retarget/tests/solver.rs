@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use retarget::internals::{mat_to_quat, Pose};
-use retarget::internals::{Solver, TaskSpec};
+use retarget::internals::{GripPoint, Solver, TaskSpec};
 use retarget::{IkConfig, SolverOptions};
 
 fn repo() -> PathBuf {
@@ -216,4 +216,54 @@ fn root_position_is_in_metres_and_far_targets_stay_finite() {
     let d = solver.solve_frame(&[far], 1.0 / 30.0).unwrap();
     assert!(solver.qpos().iter().all(|v| v.is_finite()));
     assert_eq!(d.qp_failures, 0);
+}
+
+/// A gripped point ([`GripPoint`]) moves from the previous frame as its foothold does, give or
+/// take the slip speed × dt (to first order: the rows are the point's linearised motion, 10 %
+/// here), however hard a task pulls it; the same pull without the grip takes it further; a
+/// point without a foothold in the frame before is free.
+#[test]
+fn a_gripped_sole_point_slides_no_faster_than_the_slip_speed() {
+    let model = g1();
+    let foot = model.body_id("left_ankle_roll_link").unwrap();
+    let pelvis = model.body_id("pelvis").unwrap();
+    let q0 = model.qpos0.clone();
+    let start = poses_of(&model, &q0, &[foot, pelvis]);
+    // The foot and the pelvis pulled 2 cm sideways and 1 cm forward.
+    let pull = Vector3::new(0.01, 0.02, 0.0);
+    let targets: Vec<Pose> = start.iter().map(|p| Pose { pos: p.pos + pull, ..*p }).collect();
+    let tasks = vec![
+        TaskSpec { body: foot, target: 0, pos_weight: 100.0, rot_weight: 10.0 },
+        TaskSpec { body: pelvis, target: 1, pos_weight: 100.0, rot_weight: 10.0 },
+    ];
+    let point = Vector3::new(0.1, 0.02, -0.03);
+    let world = |q: &[f64]| {
+        let mut data = Data::new(&model);
+        model.kinematics(q, &mut data);
+        data.xpos[foot] + data.xquat[foot] * point
+    };
+    let at = world(&q0);
+    // The foothold itself moves 1 mm along x per frame.
+    let step = Vector3::new(0.001, 0.0, 0.0);
+    let (dt, slip) = (1.0 / 30.0, 0.1);
+    let moved = |grip: Option<Option<Vector3<f64>>>| {
+        let mut solver =
+            Solver::new(&model, std::slice::from_ref(&tasks), SolverOptions::default()).unwrap();
+        solver.add_constraint(Box::new(retarget::internals::Grip));
+        if let Some(from) = grip {
+            let g = GripPoint { body: foot, point, at: at + step, from };
+            solver.set_grips(&[g], slip).unwrap();
+        }
+        solver.solve_frame(&targets, dt).unwrap();
+        world(solver.qpos()) - at
+    };
+    let held = moved(Some(Some(at)));
+    for axis in 0..2 {
+        let off = held[axis] - step[axis];
+        assert!(off.abs() <= 1.1 * slip * dt, "axis {axis}: {off} m past the foothold's move");
+    }
+    let free = moved(None);
+    assert!(free.xy().norm() > 0.01, "the pull alone moves the point {} m", free.xy().norm());
+    let landing = moved(Some(None));
+    assert!((landing - free).norm() < 1e-12, "a first planted frame is not held");
 }

@@ -25,6 +25,13 @@ pub struct FootPlanOptions {
     /// Weight of the contact-point task that holds the sole's contact point on its anchor
     /// in stance (the foot tasks' position weights are 50 in GMR's configs).
     pub contact_weight: f64,
+    /// A planted sole's points that stand on the floor move from one frame to the next as
+    /// their footholds do, give or take this speed (m/s) horizontally: a hard constraint of
+    /// each frame's step (`constraints::Grip`), so that no pull on the robot (the root's
+    /// smoothness, the other tasks) slides a planted foot faster, whatever the contact
+    /// weight, while a foot that lands off its foothold still reaches it. The report's
+    /// contact sliding speed (`ReportOptions::slide_speed`, 0.1 m/s).
+    pub slip_speed: f64,
     /// Least horizontal gap (m) between the two soles when both are planted at once: anchors
     /// closer than this are moved apart, half the shortfall each, along the footprints'
     /// separating axis, so that the planted feet do not ask for the soles inside each other,
@@ -85,6 +92,7 @@ impl Default for FootPlanOptions {
             stance_weight: 2.0,
             clearance: 0.002,
             contact_weight: 400.0,
+            slip_speed: 0.1,
             sole_gap: 0.03,
             swing_clearance: 0.015,
             lift_s: 1.0 / 30.0,

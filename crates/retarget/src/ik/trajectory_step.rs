@@ -111,8 +111,12 @@ impl<'m> Solver<'m> {
     }
 
     /// The constraints' rows `a · Δq ≥ b` at the current configuration (every constraint
-    /// added with [`Solver::add_constraint`]), as `(a, b)` pairs.
+    /// added with [`Solver::add_constraint`]), as `(a, b)` pairs; without the grips
+    /// ([`Solver::set_grips`]): they count from the frame before, which the window's step
+    /// moves too, so there a planted sole is held by its point tasks, and each frame's step
+    /// then holds it hard.
     pub fn constraint_rows(&mut self) -> Vec<(&[f64], f64)> {
+        self.grip_boxes.clear();
         self.make_rows();
         self.rows_made = false;
         (0..self.dense.num_rows()).filter_map(|k| self.dense.row(k)).collect()
@@ -143,6 +147,7 @@ impl<'m> Solver<'m> {
             }
         }
         self.set_bounds(dt);
+        self.make_grip_boxes(dt);
         let status = self.solve_step();
         let optimal = status == QpStatus::Optimal;
         if matches!(status, QpStatus::Optimal | QpStatus::IterationLimit) {

@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 use super::prepare::Prepared;
 use crate::feet::RobotFoot;
-use crate::ik::{PointTask, Solver, TaskSpec};
+use crate::ik::{GripPoint, PointTask, Solver, TaskSpec};
 use crate::Error;
 
 impl<'a> Prepared<'a> {
@@ -56,15 +56,27 @@ impl<'a> Prepared<'a> {
             .collect();
         solver.set_raised_geoms(&raised);
         let mut points = Vec::with_capacity(8);
+        let mut grips = Vec::with_capacity(8);
         let w = self.contact_weight();
         for (side, (foot, contact)) in feet.iter().zip(&plan.contact[f]).enumerate() {
             let Some(foot) = foot else { continue };
             let body = foot.body;
             solver.set_weight_scale(body, plan.weight[f][side], 1.0);
+            let before = f.checked_sub(1).map_or(&[][..], |b| &plan.contact[b][side][..]);
             for p in contact {
                 let (h, v) = (w * p.horizontal, w * p.vertical);
                 let weight = Vector3::new(h, h, v);
                 points.push(PointTask { body, point: p.point, target: p.at, weight });
+                // The points a planted sole stands on: held on their footholds.
+                if p.vertical > 0.0 && p.horizontal > 0.0 {
+                    let from = before.iter().find(|b| b.point == p.point && b.vertical > 0.0);
+                    grips.push(GripPoint {
+                        body,
+                        point: p.point,
+                        at: p.at,
+                        from: from.map(|b| b.at),
+                    });
+                }
             }
             if let (Some(data), Some(floor)) = (at, plan.swing_floor[f][side]) {
                 let rot = data.xquat[body];
@@ -81,6 +93,7 @@ impl<'a> Prepared<'a> {
                 }
             }
         }
+        solver.set_grips(&grips, self.grip_slip_speed())?;
         solver.set_point_tasks(&points)
     }
 }

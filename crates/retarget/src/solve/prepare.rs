@@ -15,7 +15,7 @@ use super::{
     ClipDiagnostics, RetargetOptions, SelfCollisionMode, SpeedLimits, StageReport, SubjectHeight,
 };
 use crate::config::IkConfig;
-use crate::constraints::{Ground, SelfCollision};
+use crate::constraints::{Grip, Ground, SelfCollision};
 use crate::feet::{FootPlan, RobotFoot};
 use crate::ik::{FrameDiagnostics, Solver, TaskSpec};
 use crate::lie::Pose;
@@ -112,6 +112,11 @@ impl<'a> Prepared<'a> {
     /// foot plan).
     pub(super) fn contact_weight(&self) -> f64 {
         self.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.contact_weight)
+    }
+
+    /// How fast a planted sole's points may slide ([`crate::FootPlanOptions::slip_speed`]).
+    pub(super) fn grip_slip_speed(&self) -> f64 {
+        self.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.slip_speed)
     }
 
     /// A solver for this clip: GMR's, or with the default mode's constraints.
@@ -238,6 +243,8 @@ pub(crate) fn build_solver<'m>(
             let limits: Vec<Option<f64>> = model.joints.iter().map(|j| j.velocity_limit).collect();
             solver.set_speed_limits(&limits)?;
         }
+        // Last: the constraint dropped first where a frame cannot hold them all.
+        solver.add_constraint(Box::new(Grip));
     }
     Ok(solver)
 }

@@ -8,7 +8,8 @@
 //!         + Σ_t  ½ Σ_i W_i (a_{t,i})²               a_t = (q_{t+1} ⊖ q_t) − (q_t ⊖ q_{t−1}), over dt²
 //! subject to     joint ranges, joint speeds |q_t ⊖ q_{t−1}| ≤ v dt,
 //!                every collision geom above the floor (a swing sole above its clearance),
-//!                the robot's geoms apart
+//!                the robot's geoms apart, a planted sole's points moving from frame to frame
+//!                as their footholds do ± the slip speed × dt (`grip_terms`)
 //! ```
 //!
 //! `W` weighs the acceleration of every velocity coordinate, the free root's translation and
@@ -41,7 +42,7 @@ use nalgebra::DVectorView;
 
 use super::banded::Banded;
 use super::dynamics_term::{Centroidal, DynamicsOptions, FrameState};
-use crate::ik::{FrameDiagnostics, Solver};
+use crate::ik::{grip_bounds, FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::Error;
 
@@ -252,6 +253,8 @@ pub(crate) struct Trajectory<'s, 'm> {
     centroidal: Option<Centroidal>,
     states: Vec<FrameState>,
     scratch: Vec<f64>,
+    /// Kinematics of the frame before the one whose grips are added ([`Trajectory::grip_terms`]).
+    before: Data,
 }
 
 impl<'s, 'm> Trajectory<'s, 'm> {
@@ -273,6 +276,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             centroidal: Centroidal::new(model, &options.dynamics),
             states: Vec::new(),
             scratch: Vec::new(),
+            before: Data::new(model),
             solver,
         }
     }
@@ -359,6 +363,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         for k in 0..n {
             self.frame_terms(frames, first + k, k, &seq.qpos[k * nq..(k + 1) * nq])?;
             self.record_state(seq.fixed.len() + k);
+            // The frame before, `dt` earlier (none before the clip's first frame).
+            let before = (seq.fixed.len() + k).checked_sub(1).map(|j| seq.at(j).to_vec());
+            self.grip_terms(k, before.as_deref());
         }
         self.smoothness_terms(seq);
         self.speed_terms(seq);
@@ -392,6 +399,87 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             }
         }
         Ok(())
+    }
+
+    /// Frame `k`'s grips ([`crate::constraints::Grip`]) in the window's model, the solver
+    /// configured at frame `k` and `before` the frame before it: a planted sole's point stays
+    /// in its box ([`crate::ik::grip_bounds`]: where it was, moved as its foothold moved,
+    /// ± the slip speed × dt) in x and y. A point at or past a bound is held there, as the
+    /// other constraints' rows are (stiff penalty): `½ ρ (e + J_k δ_k − J_{k−1} δ_{k−1})²`,
+    /// `e` how far past the bound it is (0 at it), the frame before's part where it is in
+    /// the window. (Without it the window's
+    /// step slid the planted feet wherever the smoothness outweighed their point tasks, which
+    /// each frame's step then pulled back: a frame out of line with both its neighbours.)
+    fn grip_terms(&mut self, k: usize, before: Option<&[f64]>) {
+        let Some(before) = before else { return };
+        let (grips, slip) = self.solver.grips();
+        if !grips.iter().any(|g| g.from.is_some()) {
+            return;
+        }
+        let grips = grips.to_vec();
+        let model = self.solver.robot();
+        let nv = model.nv;
+        model.kinematics(before, &mut self.before);
+        let data = self.solver.data();
+        let half = slip * self.dt;
+        let (rho, slack) = (self.options.active_penalty, self.options.active_slack);
+        let (mut now, mut then) = (vec![0.0; nv], vec![0.0; nv]);
+        for g in grips.iter().filter(|g| g.from.is_some()) {
+            let p = data.xpos[g.body] + data.xquat[g.body] * g.point;
+            let was = self.before.xpos[g.body] + self.before.xquat[g.body] * g.point;
+            let (lo, hi) = grip_bounds(&was, g, half);
+            for axis in 0..2 {
+                // How far past the bound the point is at or near (0 at it).
+                let e = if p[axis] < lo[axis] + slack {
+                    (p[axis] - lo[axis]).min(0.0)
+                } else if p[axis] > hi[axis] - slack {
+                    (p[axis] - hi[axis]).max(0.0)
+                } else {
+                    continue;
+                };
+                now.fill(0.0);
+                then.fill(0.0);
+                for (d, column) in model.jac_point_columns(data, g.body, p) {
+                    now[d] = column[axis];
+                }
+                for (d, column) in model.jac_point_columns(&self.before, g.body, was) {
+                    then[d] = column[axis];
+                }
+                let nz = |v: &[f64]| (0..nv).filter(|&d| v[d] != 0.0).collect::<Vec<_>>();
+                let (a, b) = (nz(&now), nz(&then));
+                {
+                    let block = self.banded.diag_mut(k);
+                    for &i in &a {
+                        for &j in &a {
+                            block[(i, j)] += rho * now[i] * now[j];
+                        }
+                    }
+                }
+                for &i in &a {
+                    self.banded.rhs_mut(k)[i] -= rho * now[i] * e;
+                }
+                // The frame before's part, where it is in the window.
+                if k > 0 && !b.is_empty() {
+                    {
+                        let block = self.banded.diag_mut(k - 1);
+                        for &i in &b {
+                            for &j in &b {
+                                block[(i, j)] += rho * then[i] * then[j];
+                            }
+                        }
+                    }
+                    let block = self.banded.block_mut(k, 1);
+                    for &i in &a {
+                        for &j in &b {
+                            block[(i, j)] -= rho * now[i] * then[j];
+                        }
+                    }
+                    for &i in &b {
+                        self.banded.rhs_mut(k - 1)[i] += rho * then[i] * e;
+                    }
+                }
+            }
+        }
     }
 
     /// The dynamics term's states of the fixed frames (the solver's kinematics are moved).
