@@ -250,6 +250,8 @@ pub struct Solver<'m> {
     slip_speed: f64,
     grip_boxes: Vec<GripBox>,
     grips_dt: f64,
+    /// Whether `grip_boxes` are made for the current `previous` and grips.
+    grip_boxes_made: bool,
     /// Kinematics of `previous` (the grips' boxes).
     previous_data: Data,
     /// Whether `data`'s geoms and sites are at its bodies' poses ([`Solver::take_step`]).
@@ -350,6 +352,7 @@ impl<'m> Solver<'m> {
             slip_speed: 0.0,
             grip_boxes: Vec::new(),
             grips_dt: 0.0,
+            grip_boxes_made: false,
             previous_data: Data::new(model),
             geoms_placed: true,
         };
@@ -404,6 +407,7 @@ impl<'m> Solver<'m> {
             self.grips.extend_from_slice(grips);
             self.slip_speed = slip_speed;
             self.rows_made = false;
+            self.grip_boxes_made = false;
         }
         Ok(())
     }
@@ -416,6 +420,11 @@ impl<'m> Solver<'m> {
 
     /// The grips' boxes for a step `dt` after [`Solver::previous`]'s configuration.
     pub(super) fn make_grip_boxes(&mut self, dt: f64) {
+        // The same frame's later steps: the boxes stand (made from `previous` and the grips).
+        if self.grip_boxes_made && self.grips_dt == dt {
+            return;
+        }
+        self.grip_boxes_made = true;
         self.grip_boxes.clear();
         self.grips_dt = dt;
         if dt <= 0.0 || !self.grips.iter().any(|g| g.from.is_some()) {
@@ -487,6 +496,7 @@ impl<'m> Solver<'m> {
     pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> Result<FrameDiagnostics, Error> {
         self.check_targets(targets)?;
         self.previous.copy_from_slice(&self.qpos);
+        self.grip_boxes_made = false;
         self.rows_made = false;
         self.qp_failures = 0;
         self.relaxed_steps = 0;

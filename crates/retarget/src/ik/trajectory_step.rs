@@ -46,6 +46,7 @@ impl<'m> Solver<'m> {
     pub fn set_previous(&mut self, previous: &[f64]) -> Result<(), Error> {
         self.check_qpos(previous)?;
         self.previous.copy_from_slice(previous);
+        self.grip_boxes_made = false;
         Ok(())
     }
 
@@ -117,6 +118,7 @@ impl<'m> Solver<'m> {
     /// then holds it hard.
     pub fn constraint_rows(&mut self) -> Vec<(&[f64], f64)> {
         self.grip_boxes.clear();
+        self.grip_boxes_made = false;
         self.make_rows();
         self.rows_made = false;
         (0..self.dense.num_rows()).filter_map(|k| self.dense.row(k)).collect()
