@@ -83,6 +83,25 @@ fn streaming_equals_the_clip_with_the_causal_solve() {
     assert!(max_difference(&planted.qpos, &streamed) > 1e-3);
 }
 
+/// An in-place loop (the XNA dude's walk cycle, its feet sliding back on its floor): the
+/// default clip walks it off its treadmill (stage 0, from the whole clip's belt), which a
+/// stream cannot; the causal clip, which a stream equals, does not either.
+#[test]
+fn an_in_place_loop_stays_on_its_treadmill_in_the_causal_solve() {
+    let Some(path) = shared::shared_file("data/fbx/xna_dude_walk_fbxsdk2017.fbx") else { return };
+    let clip = retarget::FbxClip::read(&path, None).unwrap();
+    let mut options = RetargetOptions::causal();
+    options.fk = clip.fk_options(&fk::FkOptions::default());
+    options.human_height = Some(1.75);
+    let causal = Retargeter::new("unitree_g1").unwrap().with_options(options.clone());
+    let (_, diag) = causal.retarget_bvh(&clip.bvh).unwrap();
+    assert!(diag.stages.iter().all(|s| s.stage != "treadmill"), "{:?}", diag.stages);
+    options.mode = SolveMode::default();
+    let full = Retargeter::new("unitree_g1").unwrap().with_options(options);
+    let (_, diag) = full.retarget_bvh(&clip.bvh).unwrap();
+    assert!(diag.stages.iter().any(|s| s.stage == "treadmill"), "{:?}", diag.stages);
+}
+
 #[test]
 fn frames_are_read_by_name_in_any_order() {
     let Some(human) = lafan1_walk(40) else { return };

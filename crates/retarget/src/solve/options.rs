@@ -124,8 +124,9 @@ impl Default for PlausibleOptions {
 
 impl PlausibleOptions {
     /// The causal part of the default solve: GMR's tasks with the hard constraints (ground,
-    /// self-collision, joint speed), warm-started frame by frame; no foot planting, no
-    /// smoothing and no backward pass, which all need the frames that follow. What streaming
+    /// self-collision, joint speed), warm-started frame by frame; no foot planting (nor the
+    /// treadmill stage that goes with it), no smoothing and no backward pass, which all need
+    /// the frames that follow. What streaming
     /// ([`crate::Retargeter::step`]) runs; a clip solved with it gives the same numbers.
     #[must_use]
     pub fn causal() -> PlausibleOptions {

@@ -13,7 +13,8 @@ use crate::Planting;
 /// The stages a solve runs, each with its options; `None` (or `false`): the stage does not run.
 #[derive(Debug, Clone)]
 pub(crate) struct Pipeline {
-    /// Stage 0: a source on a treadmill put on a floor that stays put (found with `contacts`).
+    /// Stage 0: a source on a treadmill put on a floor that stays put (found with `contacts`),
+    /// where the feet are planted.
     pub treadmill: bool,
     /// Stage 2: how the source's contact phases are found (they are written in every mode).
     pub contacts: ContactOptions,
@@ -64,7 +65,9 @@ impl Pipeline {
             ..options.solver.clone()
         };
         Pipeline {
-            treadmill: true,
+            // The belt is the whole clip's median (as planting needs the whole clip): a stream
+            // cannot run it, so the causal solve (planting off) does not either.
+            treadmill: planting,
             contacts: p.contact.clone(),
             foot_plan: planting.then(|| p.feet.clone()),
             reweigh: planting.then(|| ReweighOptions::from(p)),
