@@ -114,8 +114,8 @@ impl<'m> Solver<'m> {
     /// The constraints' rows `a · Δq ≥ b` at the current configuration (every constraint
     /// added with [`Solver::add_constraint`]), as `(a, b)` pairs; without the grips
     /// ([`Solver::set_grips`]): they count from the frame before, which the window's step
-    /// moves too, so there a planted sole is held by its point tasks, and each frame's step
-    /// then holds it hard.
+    /// moves too, so the window holds them coupled with that frame (`grip_terms` in
+    /// `crate::solve::trajectory`).
     pub fn constraint_rows(&mut self) -> Vec<(&[f64], f64)> {
         self.grip_boxes.clear();
         self.grip_boxes_made = false;

@@ -102,6 +102,41 @@ impl Banded {
         }
     }
 
+    /// Adds the penalty `½ ρ (a · x_t − c · x_{t−1} − b)²` (`rho` = ρ): a row of frame `t`
+    /// alone (`c`: none), or one that couples it with the frame before.
+    pub fn add_penalty(&mut self, t: usize, a: &[f64], c: Option<&[f64]>, b: f64, rho: f64) {
+        let nz = |v: &[f64]| (0..v.len()).filter(|&d| v[d] != 0.0).collect::<Vec<_>>();
+        let ia = nz(a);
+        let block = &mut self.diag[t];
+        for &i in &ia {
+            for &j in &ia {
+                block[(i, j)] += rho * a[i] * a[j];
+            }
+        }
+        let mut rhs = self.rhs_mut(t);
+        for &i in &ia {
+            rhs[i] += rho * a[i] * b;
+        }
+        let Some(c) = c else { return };
+        let ic = nz(c);
+        let block = &mut self.diag[t - 1];
+        for &i in &ic {
+            for &j in &ic {
+                block[(i, j)] += rho * c[i] * c[j];
+            }
+        }
+        let block = &mut self.sub1[t];
+        for &i in &ia {
+            for &j in &ic {
+                block[(i, j)] -= rho * a[i] * c[j];
+            }
+        }
+        let mut rhs = self.rhs_mut(t - 1);
+        for &i in &ic {
+            rhs[i] -= rho * c[i] * b;
+        }
+    }
+
     /// Frame `t`'s part of the right-hand side.
     pub fn rhs_mut(&mut self, t: usize) -> nalgebra::DVectorViewMut<'_, f64> {
         let n = self.n;

@@ -364,8 +364,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             self.frame_terms(frames, first + k, k, &seq.qpos[k * nq..(k + 1) * nq])?;
             self.record_state(seq.fixed.len() + k);
             // The frame before, `dt` earlier (none before the clip's first frame).
-            let before = (seq.fixed.len() + k).checked_sub(1).map(|j| seq.at(j).to_vec());
-            self.grip_terms(k, before.as_deref());
+            let before = (seq.fixed.len() + k).checked_sub(1).map(|j| seq.at(j));
+            self.grip_terms(k, before);
         }
         self.smoothness_terms(seq);
         self.speed_terms(seq);
@@ -422,7 +422,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         model.kinematics(before, &mut self.before);
         let data = self.solver.data();
         let half = slip * self.dt;
-        let (rho, slack) = (self.options.active_penalty, self.options.active_slack);
+        let slack = self.options.active_slack;
         let (mut now, mut then) = (vec![0.0; nv], vec![0.0; nv]);
         for g in grips.iter().filter(|g| g.from.is_some()) {
             let p = data.xpos[g.body] + data.xquat[g.body] * g.point;
@@ -445,39 +445,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                 for (d, column) in model.jac_point_columns(&self.before, g.body, was) {
                     then[d] = column[axis];
                 }
-                let nz = |v: &[f64]| (0..nv).filter(|&d| v[d] != 0.0).collect::<Vec<_>>();
-                let (a, b) = (nz(&now), nz(&then));
-                {
-                    let block = self.banded.diag_mut(k);
-                    for &i in &a {
-                        for &j in &a {
-                            block[(i, j)] += rho * now[i] * now[j];
-                        }
-                    }
-                }
-                for &i in &a {
-                    self.banded.rhs_mut(k)[i] -= rho * now[i] * e;
-                }
-                // The frame before's part, where it is in the window.
-                if k > 0 && !b.is_empty() {
-                    {
-                        let block = self.banded.diag_mut(k - 1);
-                        for &i in &b {
-                            for &j in &b {
-                                block[(i, j)] += rho * then[i] * then[j];
-                            }
-                        }
-                    }
-                    let block = self.banded.block_mut(k, 1);
-                    for &i in &a {
-                        for &j in &b {
-                            block[(i, j)] -= rho * now[i] * then[j];
-                        }
-                    }
-                    for &i in &b {
-                        self.banded.rhs_mut(k - 1)[i] += rho * then[i] * e;
-                    }
-                }
+                // The frame before's part where it is in the window.
+                let before = (k > 0).then_some(&then[..]);
+                self.banded.add_penalty(k, &now, before, -e, self.options.active_penalty);
             }
         }
     }
@@ -582,17 +552,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             .map(|(a, b)| (a.to_vec(), b.max(0.0)))
             .collect();
         for (a, b) in rows {
-            let nz: Vec<usize> = (0..nv).filter(|&d| a[d] != 0.0).collect();
-            let block = self.banded.diag_mut(k);
-            for &i in &nz {
-                for &j in &nz {
-                    block[(i, j)] += rho * a[i] * a[j];
-                }
-            }
-            let mut rhs = self.banded.rhs_mut(k);
-            for &i in &nz {
-                rhs[i] += rho * a[i] * b;
-            }
+            self.banded.add_penalty(k, &a, None, b, rho);
         }
         // Joints at a range end stay there.
         for joint in &model.joints {
