@@ -18,7 +18,8 @@
 //! block-pentadiagonal system (`banded.rs`: a second difference couples three frames)
 //! in which the constraints that are active (within [`TrajectoryOptions::active_slack`] of
 //! their bound, or past it) are held by a stiff penalty
-//! ([`TrajectoryOptions::active_penalty`]); then one sweep over the frames solves each
+//! ([`TrajectoryOptions::active_penalty`]), solved and taken twice, linearised afresh
+//! ([`TrajectoryOptions::banded_steps`]); then one sweep over the frames solves each
 //! frame's subproblem exactly, its neighbours held, every constraint a hard row of the frame's
 //! QP ([`crate::ik::Solver::trajectory_step`]). The sweep makes the result feasible and finds the
 //! constraints the next iteration holds; the banded step moves the whole window, which a
@@ -64,8 +65,13 @@ pub struct TrajectoryOptions {
     /// wrist held by one light rotation task as much as a knee. (One weight for every joint
     /// held the G1's wrists 9–10° off their targets on the LAFAN1 jumps, `--gmr` 1°.)
     pub joint_cutoff_hz: f64,
-    /// Gauss–Newton iterations (a banded step and a sweep each).
+    /// Iterations, each [`TrajectoryOptions::banded_steps`] banded steps and a sweep.
     pub iterations: usize,
+    /// Gauss–Newton steps of the whole window per iteration, each linearised where the one
+    /// before it ended. One step left the model's linearisation behind where it turned a joint
+    /// far (a waist or hip yaw 0.3–0.45 rad in a step, a planted sole's points 5–12 mm out of
+    /// their grip on the SOMA walk onto the T1), and the sweep pulls a frame back only so far.
+    pub banded_steps: usize,
     /// Window length (s).
     pub window_s: f64,
     /// Frames at the end of a window solved again by the next window (s).
@@ -103,6 +109,7 @@ impl Default for TrajectoryOptions {
             joints: 2e-5,
             joint_cutoff_hz: 8.0,
             iterations: 2,
+            banded_steps: 2,
             window_s: 8.0,
             overlap_s: 1.0,
             max_step: 0.5,
@@ -306,7 +313,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         self.joint_weights(frames, first, &seq)?;
         let mut diagnostics = Vec::new();
         for _ in 0..self.options.iterations {
-            self.banded_step(frames, first, &mut seq)?;
+            for _ in 0..self.options.banded_steps {
+                self.banded_step(frames, first, &mut seq)?;
+            }
             diagnostics = self.sweep(frames, first, &mut seq)?;
         }
         Ok(diagnostics)
