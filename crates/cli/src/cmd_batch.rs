@@ -322,13 +322,10 @@ impl Job {
         let Some(config) = self.given.clone() else {
             bail!("{}: a C3D clip needs --config (a marker config)", src.display());
         };
-        let file = c3d::C3d::from_path(src).with_context(|| format!("{}", src.display()))?;
-        let name = src.display().to_string();
-        let clip = markers.motion(&file, &name, self.retargeter.options().human_height)?;
-        let (motion, diag) = self
-            .retargeter
-            .retarget_with(&clip.human, &config, clip.height)
-            .with_context(|| format!("{}: retargeting", src.display()))?;
+        // Its errors name the file once (the C3D reader's, the marker bodies', the solve's).
+        let file = c3d::C3d::from_path(src)?;
+        let (motion, diag) =
+            self.retargeter.retarget_c3d(&file, &src.display().to_string(), markers, &config)?;
         Ok((motion, diag, config))
     }
 }

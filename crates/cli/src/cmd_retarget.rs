@@ -9,9 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use clap::Args;
 use retarget::writers::{write_motion, Format};
-use retarget::{
-    ClipDiagnostics, IkConfig, MarkerConfig, RetargetOptions, Retargeter, RobotMotion, SolveMode,
-};
+use retarget::{ClipDiagnostics, IkConfig, RetargetOptions, Retargeter, RobotMotion, SolveMode};
 
 #[derive(Args, Debug)]
 pub struct MainArgs {
@@ -142,14 +140,9 @@ pub fn run_main(args: MainArgs) -> anyhow::Result<ExitCode> {
         let models = args.smpl.models();
         crate::cmd_smpl::retarget_file(&retargeter, &input, &models, args.smpl.gender)?
     } else if args.c3d.is_some() {
+        // Its errors name the file once (the C3D reader's, the marker bodies', the solve's).
         let config_path = args.config.as_deref().context("--c3d needs --config")?;
-        let config = IkConfig::from_file(config_path)?;
-        let markers = MarkerConfig::from_file(config_path)?;
-        let file = c3d::C3d::from_path(&input).with_context(|| format!("{}", input.display()))?;
-        let clip = markers.motion(&file, &input.display().to_string(), args.human_height)?;
-        retargeter
-            .retarget_with(&clip.human, &config, clip.height)
-            .with_context(|| format!("{}: retargeting onto {robot}", input.display()))?
+        retargeter.retarget_c3d_file(&input, config_path)?
     } else {
         if let Some(path) = &args.config {
             retargeter = retargeter.with_config(IkConfig::from_file(path)?);

@@ -5,30 +5,41 @@
 #[path = "../../../tests/support/shared.rs"]
 mod shared;
 
-use std::path::Path;
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 fn repo(path: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(path)
 }
 
-#[test]
-fn vicon_walk_onto_g1_alternates_feet_on_the_ground() {
-    let Some(c3d) = shared::shared_file("data/c3d/c3dorg_s00_Vicon_pyCGM2_Walking01.c3d") else {
-        return;
-    };
-    let dir = std::env::temp_dir().join(format!("cli_c3d_retarget_{}", std::process::id()));
+/// The shared Vicon walk and a fresh temporary directory named after `tag`.
+fn walk_and_dir(tag: &str) -> Option<(PathBuf, PathBuf)> {
+    let walk = shared::shared_file("data/c3d/c3dorg_s00_Vicon_pyCGM2_Walking01.c3d")?;
+    let dir = std::env::temp_dir().join(format!("{tag}_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
+    Some((walk, dir))
+}
+
+/// `retarget --c3d c3d --robot unitree_g1 --config config -o out`.
+fn retarget_c3d(c3d: &Path, config: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_retarget"))
+        .args(["--robot", "unitree_g1", "--c3d"])
+        .arg(c3d)
+        .arg("--config")
+        .arg(config)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn vicon_walk_onto_g1_alternates_feet_on_the_ground() {
+    let Some((c3d, dir)) = walk_and_dir("cli_c3d_retarget") else { return };
     let out_path = dir.join("walk.npz");
     let config = repo("configs/c3d_plugingait_to_unitree_g1.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_retarget"))
-        .args(["--c3d", c3d.to_str().unwrap(), "--robot", "unitree_g1", "--config"])
-        .arg(&config)
-        .arg("-o")
-        .arg(&out_path)
-        .output()
-        .unwrap();
+    let out = retarget_c3d(&c3d, &config, &out_path);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
@@ -107,5 +118,77 @@ fn vicon_walk_onto_g1_alternates_feet_on_the_ground() {
     for m in sole_bottom {
         assert!(m > -0.05, "lowest sole point {m} m");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The Vicon walk's first frame (markers only) a long way off: the marker bodies refuse it.
+fn far_off_walk(source: &Path, path: &Path) {
+    let mut file = c3d::C3d::from_path(source).unwrap();
+    let labels = file.points.labels.clone();
+    let mut points = c3d::Points::new(labels.clone(), 1);
+    for k in 0..labels.len() {
+        let far = file.points.get(0, k).map(|mut p| {
+            p.position[0] *= 1e25;
+            p
+        });
+        points.set(0, k, far);
+    }
+    file.points = points;
+    file.analog = c3d::Analog::new(Vec::new(), file.point_rate, 1, 1);
+    file.write(std::fs::File::create(path).unwrap(), c3d::Format::INTEL_FLOAT).unwrap();
+}
+
+/// A C3D clip that the reader, the marker bodies or the solve refuses: one line that names
+/// the file once, from the main command and from a batch (a call of the library wrapped in
+/// the file's context named it twice where the marker bodies refused the clip).
+#[test]
+fn a_bad_c3d_clip_is_named_once() {
+    let Some((walk, dir)) = walk_and_dir("cli_c3d_bad") else { return };
+    let (inputs, outputs) = (dir.join("in"), dir.join("out"));
+    std::fs::create_dir_all(&inputs).unwrap();
+    std::fs::write(inputs.join("garbage.c3d"), b"not a c3d file").unwrap();
+    far_off_walk(&walk, &inputs.join("far.c3d"));
+    std::fs::copy(&walk, inputs.join("walk.c3d")).unwrap();
+    // The IK tables track `Trunk`, which the marker bodies no longer make: the solve refuses.
+    let config = std::fs::read_to_string(repo("configs/c3d_plugingait_to_unitree_g1.json"))
+        .unwrap()
+        .replace(r#""Trunk": { "markers""#, r#""Chest": { "markers""#);
+    let config_path = dir.join("no_trunk.json");
+    std::fs::write(&config_path, config).unwrap();
+    let cases = [
+        ("garbage.c3d", "not a c3d file"),
+        ("far.c3d", "marker bodies: frame 0: marker `PELO`"),
+        ("walk.c3d", "unknown human body `Trunk`"),
+    ];
+    let named_once = |text: &str, path: &Path| {
+        let path = path.display().to_string();
+        text.matches(&path).count() == 1 && text.contains(&format!("{path}: "))
+    };
+    for (name, why) in cases {
+        let input = inputs.join(name);
+        let out = retarget_c3d(&input, &config_path, &dir.join("out.npz"));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let text = stderr.trim();
+        assert_eq!(out.status.code(), Some(1), "{name}: {text}");
+        assert_eq!(text.lines().count(), 1, "{name}: {text}");
+        assert!(text.starts_with(&format!("error: {}: ", input.display())), "{text}");
+        assert!(named_once(text, &input) && text.contains(why), "{name}: {text}");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_retarget"))
+        .args(["batch", inputs.to_str().unwrap(), "--robot", "unitree_g1", "--config"])
+        .arg(&config_path)
+        .arg("-o")
+        .arg(&outputs)
+        .output()
+        .unwrap();
+    let summary = std::fs::read_to_string(outputs.join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let rows = summary["clips"].as_array().unwrap();
+    for (name, why) in cases {
+        let row = rows.iter().find(|r| r["input"] == name).unwrap();
+        let error = row["error"].as_str().unwrap();
+        assert!(named_once(error, &inputs.join(name)) && error.contains(why), "{name}: {error}");
+    }
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -385,7 +385,9 @@ impl Retargeter {
     }
 
     /// Retargets a C3D clip through the virtual marker bodies of `markers` with `config` (the
-    /// marker config is usually the IK config file too). `name` names the file in messages.
+    /// marker config is usually the IK config file too). `name` names the file in messages,
+    /// once: the marker bodies' errors say it themselves, the solve's are wrapped in
+    /// [`Error::InFile`].
     pub fn retarget_c3d(
         &self,
         file: &c3d::C3d,
@@ -395,6 +397,7 @@ impl Retargeter {
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
         let clip = markers.motion(file, name, self.options.human_height)?;
         self.retarget_with(&clip.human, config, clip.height)
+            .map_err(|e| Error::InFile { path: name.to_owned(), source: Box::new(e) })
     }
 
     /// [`Retargeter::retarget_c3d`] of the C3D file at `path` with the marker-driven IK config
@@ -405,12 +408,11 @@ impl Retargeter {
         path: &Path,
         config: &Path,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-        let name = path.display().to_string();
-        let file = c3d::C3d::from_path(path)
-            .map_err(|e| Error::InFile { path: name.clone(), source: Box::new(e.into()) })?;
+        // c3d's errors name the file.
+        let file = c3d::C3d::from_path(path)?;
         let markers = MarkerConfig::from_file(config)?;
         let ik = IkConfig::from_file(config)?;
-        self.retarget_c3d(&file, &name, &markers, &ik)
+        self.retarget_c3d(&file, &path.display().to_string(), &markers, &ik)
     }
 
     /// Retargets a human motion with `config` and the subject height `height` (the one the
