@@ -333,8 +333,9 @@ where
         }
         Err(err) => {
             row.status = "failed".to_string();
-            row.error = Some(format!("{err:#}"));
-            progress.clip_done(&row.input, &format!("FAILED: {err:#}"), 0);
+            let error = crate::errors::error_chain(&err);
+            progress.clip_done(&row.input, &format!("FAILED: {error}"), 0);
+            row.error = Some(error);
         }
     }
     row
