@@ -96,6 +96,15 @@ pub enum Error {
     /// definite; `message` says which.
     #[error("frame {frame}: {message}")]
     Numerical { frame: usize, message: String },
+    /// A streamed frame ([`crate::HumanFrame`]) whose poses do not match its body names.
+    #[error(
+        "frame {frame}: {names} body names but {positions} positions and {orientations} orientations"
+    )]
+    FrameShape { frame: usize, names: usize, positions: usize, orientations: usize },
+    /// A streamed frame without a body of the first frame (the first frame fixes which bodies
+    /// the config reads).
+    #[error("frame {frame}: body `{body}` of the first frame is missing")]
+    FrameMissingBody { frame: usize, body: String },
     /// A motion handed to a writer with a non-finite `qpos` entry.
     #[error("qpos of frame {frame}, entry {index} is not finite ({value})")]
     NonFiniteQpos { frame: usize, index: usize, value: f64 },

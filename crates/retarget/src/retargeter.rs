@@ -642,12 +642,12 @@ impl Stream {
     fn step(&mut self, frame: &HumanFrame) -> Result<&[f64], Error> {
         let n = frame.body_names.len();
         if frame.positions.len() != n || frame.orientations.len() != n {
-            return Err(Error::InvalidOption(format!(
-                "frame {}: {n} body names but {} positions and {} orientations",
-                self.frames,
-                frame.positions.len(),
-                frame.orientations.len()
-            )));
+            return Err(Error::FrameShape {
+                frame: self.frames,
+                names: n,
+                positions: frame.positions.len(),
+                orientations: frame.orientations.len(),
+            });
         }
         let (positions, orientations) = if frame.body_names == self.names {
             (frame.positions.as_slice(), frame.orientations.as_slice())
@@ -684,10 +684,7 @@ impl Stream {
         self.orientations.clear();
         for name in &self.names {
             let Some((position, orientation)) = frame.pose(name) else {
-                return Err(Error::InvalidOption(format!(
-                    "frame {}: body `{name}` of the first frame is missing",
-                    self.frames
-                )));
+                return Err(Error::FrameMissingBody { frame: self.frames, body: name.clone() });
             };
             self.positions.push(*position);
             self.orientations.push(*orientation);

@@ -129,8 +129,22 @@ fn frames_are_read_by_name_in_any_order() {
     frame.body_names.remove(gone);
     frame.positions.remove(gone);
     frame.orientations.remove(gone);
-    let err = shuffled.step(&frame).unwrap_err().to_string();
-    assert!(err.contains("`LeftHand`"), "{err}");
+    let err = shuffled.step(&frame).unwrap_err();
+    assert!(
+        matches!(&err, retarget::Error::FrameMissingBody { frame: 40, body } if body == "LeftHand"),
+        "{err}"
+    );
+    // A frame whose poses do not match its names is told apart.
+    let mut short = frame.clone();
+    short.positions.pop();
+    let err = shuffled.step(&short).unwrap_err();
+    let shape = retarget::Error::FrameShape {
+        frame: 40,
+        names: frame.body_names.len(),
+        positions: frame.body_names.len() - 1,
+        orientations: frame.body_names.len(),
+    };
+    assert_eq!(err.to_string(), shape.to_string());
     // A fresh stream whose first frame lacks a config body is refused.
     let mut fresh = Retargeter::new("unitree_g1").unwrap();
     let err = fresh.step(&frame).unwrap_err().to_string();

@@ -105,7 +105,7 @@ impl HumanBody {
         let index = |role: Role| joints.get(&role).and_then(|n| motion.body_index(n));
         let n = motion.num_frames;
         if n == 0 {
-            return Err(Error::InvalidOption(format!("{source}: the motion has no frames")));
+            return Err(fk::Error::NoFrames.into());
         }
         let count = n.min(POSTURES);
         let picked: Vec<usize> =
