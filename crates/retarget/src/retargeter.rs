@@ -424,7 +424,8 @@ impl Retargeter {
         config: &IkConfig,
         height: SubjectHeight,
     ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-        crate::solve::solve_clip(human, &self.model, config, &self.options, &height)
+        let roles = &self.options.fk.roles;
+        crate::solve::solve_clip(human, &self.model, config, &self.options, &height, roles)
     }
 
     /// Writes a motion of this robot (format from the extension, or `format`), atomically.

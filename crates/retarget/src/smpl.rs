@@ -118,7 +118,7 @@ impl Retargeter {
             source: Box::new(e),
         };
         let gmr = crate::solve::Pipeline::new(self.options()).is_gmr();
-        let mut options = self.options().clone();
+        let options = self.options();
         let (human, height) = if gmr {
             let resampled = smpl::gmr::offline_fast(body, motion, smpl::conventions::GMR_FPS)
                 .map_err(|e| in_file(e.into()))?;
@@ -131,17 +131,21 @@ impl Retargeter {
         };
         let height = options.human_height.map_or(height, SubjectHeight::given);
         // The source's feet for the contact phases (both modes write them), by role.
-        for (role, joint) in clip.roles() {
-            options.fk.roles.entry(role).or_insert(joint);
-        }
+        let roles = crate::solve::source_roles(&options.fk.roles, clip.roles());
         if human.num_frames == 0 {
             return Err(in_file(Error::InvalidOption(
                 "too few frames to retarget (GMR's path skips the first resampled frame)".into(),
             )));
         }
-        let (robot, mut diag) =
-            crate::solve::solve_clip(&human, self.model(), &chosen.config, &options, &height)
-                .map_err(in_file)?;
+        let (robot, mut diag) = crate::solve::solve_clip(
+            &human,
+            self.model(),
+            &chosen.config,
+            options,
+            &height,
+            &roles,
+        )
+        .map_err(in_file)?;
         diag.human_inferred = format!(
             "{} body model ({} joints), Z up, metres, {} fps; {}",
             body.kind,

@@ -3,13 +3,16 @@
 //! solve plants the robot's feet on them.
 
 use super::prepare::Prepared;
+use crate::contact_phases::FootPoints;
 
 impl Prepared<'_> {
-    /// The source's contact phases, where its feet are found (by role, else by name).
-    pub(super) fn detect_contacts(&mut self, human: &fk::HumanMotion) {
-        if let Some(points) =
-            crate::contact_phases::human_foot_points(&human.body_names, &self.options.fk.roles)
-        {
+    /// The source's contact phases, where its feet were found (`feet`: by role, else by name).
+    pub(super) fn detect_contacts(
+        &mut self,
+        human: &fk::HumanMotion,
+        feet: Option<[FootPoints; 2]>,
+    ) {
+        if let Some(points) = feet {
             let contact = &self.pipeline.contacts;
             self.contacts = Some(crate::contact_phases::detect(human, points, contact));
         }

@@ -32,11 +32,12 @@ pub mod trajectory;
 mod treadmill;
 mod windows;
 
+use std::collections::BTreeMap;
 use std::ops::Range;
 use std::time::Instant;
 
 use bvh::Bvh;
-use fk::HumanMotion;
+use fk::{HumanMotion, Role};
 use mjcf::Model;
 
 pub use dynamics_term::DynamicsOptions;
@@ -53,6 +54,7 @@ pub use schedule::ChunkOptions;
 pub use trajectory::TrajectoryOptions;
 
 use crate::config::IkConfig;
+use crate::contact_phases::human_foot_points;
 use crate::motion::RobotMotion;
 use crate::Error;
 use prepare::{Prepared, Solved};
@@ -70,14 +72,12 @@ pub fn retarget_bvh(
     }
     let (human, report) = fk::human_motion(bvh, &fk_options)?;
     let height = SubjectHeight { metres: report.height, source: report.height_source.clone() };
-    let mut opts = options.clone();
     // The recognised roles, so that the source's feet are found whatever their names.
-    if let Ok(humanoid) = &report.humanoid {
-        for (role, joint) in humanoid.roles.iter() {
-            opts.fk.roles.entry(role).or_insert_with(|| joint.name.clone());
-        }
-    }
-    let (motion, mut diag) = solve_clip(&human, model, config, &opts, &height)?;
+    let recognised = report.humanoid.as_ref().ok().map(|humanoid| {
+        humanoid.roles.iter().map(|(role, joint)| (role, joint.name.clone())).collect()
+    });
+    let roles = source_roles(&options.fk.roles, recognised.unwrap_or_default());
+    let (motion, mut diag) = solve_clip(&human, model, config, options, &height, &roles)?;
     diag.human_inferred = report.inferred();
     Ok((motion, diag))
 }
@@ -93,31 +93,45 @@ pub fn retarget_motion(
     let metres = options
         .human_height
         .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
-    solve_clip(human, model, config, options, &SubjectHeight::given(metres))
+    let height = SubjectHeight::given(metres);
+    solve_clip(human, model, config, options, &height, &options.fk.roles)
+}
+
+/// The roles of a source's joints: those `given` ([`fk::FkOptions::roles`]), and the
+/// `recognised` ones for the roles they leave.
+pub(crate) fn source_roles(
+    given: &BTreeMap<Role, String>,
+    recognised: BTreeMap<Role, String>,
+) -> BTreeMap<Role, String> {
+    let mut roles = recognised;
+    roles.extend(given.iter().map(|(role, joint)| (*role, joint.clone())));
+    roles
 }
 
 /// Retargets a human motion (world poses, metres, Z up) of a subject `height` tall onto
 /// `model`: the stages in order (`options.human_height` is not read: `height` is the one
-/// decided for the clip).
+/// decided for the clip). `roles` name the source's joints by role (its feet, for the
+/// contact phases, are found by them, else by common names: `human_foot_points`).
 pub(crate) fn solve_clip(
     human: &HumanMotion,
     model: &Model,
     config: &IkConfig,
     options: &RetargetOptions,
     height: &SubjectHeight,
+    roles: &BTreeMap<Role, String>,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
     let pipeline = Pipeline::new(options);
+    let feet = human_foot_points(&human.body_names, roles);
     // 0. The floor: a source on a treadmill walked off it.
-    let walked = pipeline
-        .treadmill
-        .then(|| treadmill::walk_off(human, options, &pipeline.contacts))
-        .flatten();
+    let walked = feet
+        .filter(|_| pipeline.treadmill)
+        .and_then(|feet| treadmill::walk_off(human, feet, &pipeline.contacts));
     let human = walked.as_ref().map_or(human, |(walked, _)| walked);
     // 1. The targets.
     let mut prepared = Prepared::new(human, model, config, options, &pipeline, height)?;
     prepared.reports.extend(walked.as_ref().map(|(_, report)| report.clone()));
     // 2. The source's contacts.
-    prepared.detect_contacts(human);
+    prepared.detect_contacts(human, feet);
     // 3. The foot plan.
     prepared.plan();
     // 4. Reweighing.

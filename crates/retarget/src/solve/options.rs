@@ -150,7 +150,7 @@ pub struct RetargetOptions {
     pub human_height: Option<f64>,
     pub solver: SolverOptions,
     /// FK options. Their `roles` also name the source's feet for the contact phases
-    /// (`human_foot_points`); the retargeter adds the recognised ones.
+    /// (`human_foot_points`), before the recognised ones (`solve::source_roles`).
     pub fk: FkOptions,
     /// Solve long clips as parallel chunks; `None`: one serial pass.
     pub chunk: Option<super::ChunkOptions>,

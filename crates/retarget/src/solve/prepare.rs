@@ -30,7 +30,6 @@ use fk::HumanMotion;
 pub(crate) struct Prepared<'a> {
     // (The stages' files read and write these fields.)
     pub(super) model: &'a Model,
-    pub(super) options: &'a RetargetOptions,
     /// The stages that run, and their options.
     pub(super) pipeline: &'a Pipeline,
     pub(super) stages: Vec<Vec<TaskSpec>>,
@@ -62,7 +61,7 @@ impl<'a> Prepared<'a> {
         human: &HumanMotion,
         model: &'a Model,
         config: &IkConfig,
-        options: &'a RetargetOptions,
+        options: &RetargetOptions,
         pipeline: &'a Pipeline,
         height: &'a SubjectHeight,
     ) -> Result<Prepared<'a>, Error> {
@@ -87,7 +86,6 @@ impl<'a> Prepared<'a> {
         }
         let prepared = Prepared {
             model,
-            options,
             pipeline,
             stages,
             tracked,

@@ -9,17 +9,16 @@ use std::collections::BTreeMap;
 
 use fk::HumanMotion;
 
-use super::{RetargetOptions, StageReport, StageValue};
-use crate::contact_phases::{human_foot_points, off_treadmill, treadmill, ContactOptions};
+use super::{StageReport, StageValue};
+use crate::contact_phases::{off_treadmill, treadmill, ContactOptions, FootPoints};
 
-/// `human` off its treadmill, and what was done, where it is on one (its feet found by the
-/// roles of `options.fk`, its contacts with `contact`).
+/// `human` off its treadmill, and what was done, where it is on one (its feet `feet`, its
+/// contacts with `contact`).
 pub(super) fn walk_off(
     human: &HumanMotion,
-    options: &RetargetOptions,
+    feet: [FootPoints; 2],
     contact: &ContactOptions,
 ) -> Option<(HumanMotion, StageReport)> {
-    let feet = human_foot_points(&human.body_names, &options.fk.roles)?;
     let belt = treadmill(human, feet, 0, contact)?;
     let report = StageReport {
         stage: "treadmill",
