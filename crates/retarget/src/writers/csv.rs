@@ -8,7 +8,8 @@
 
 use std::io::Write;
 
-use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, BodyPoses};
+use super::derived::{body_poses, BodyPoses};
+use super::root::{root_nq, root_pose, xyzw_from_wxyz};
 use crate::motion::RobotMotion;
 
 pub(crate) fn write_csv<W: Write>(

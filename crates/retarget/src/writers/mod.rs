@@ -20,6 +20,7 @@ mod json;
 mod npz;
 mod pickle;
 mod read;
+mod root;
 mod unpickle;
 
 use std::fs::File;
@@ -30,7 +31,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use crate::motion::RobotMotion;
 use crate::Error;
 
-pub(crate) use derived::{angular_velocity, body_poses, gradient_pair, gradient_rows, BodyPoses};
+pub(crate) use derived::{body_poses, gradient_pair, gradient_rows, BodyPoses};
 pub use npz::{read_motion_npz, read_motion_npz_bytes, read_npz_robot};
 pub use read::{read_motion, read_motion_bytes, FpsFrom, MotionFormat, MotionSource};
 
@@ -137,21 +138,6 @@ pub fn npz_arrays(
     Ok(npz::motion_arrays(motion, model))
 }
 
-/// The x y z w (scalar-last) order of a w x y z quaternion: Unitree's CSV root and GMR's
-/// `root_rot` use it. The only place where our files change quaternion order.
-#[must_use]
-pub(crate) const fn xyzw_from_wxyz(wxyz: [f64; 4]) -> [f64; 4] {
-    [wxyz[1], wxyz[2], wxyz[3], wxyz[0]]
-}
-
-/// The w x y z (scalar-first) order of an x y z w quaternion read from Unitree's CSV or
-/// GMR's `root_rot`: [`xyzw_from_wxyz`]'s inverse, the only place where read files change
-/// quaternion order.
-#[must_use]
-pub(crate) const fn wxyz_from_xyzw(xyzw: [f64; 4]) -> [f64; 4] {
-    [xyzw[3], xyzw[0], xyzw[1], xyzw[2]]
-}
-
 /// Checks that `motion` is one of `model`'s and holds only finite numbers.
 pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<(), Error> {
     if motion.nq != model.nq {
@@ -187,35 +173,6 @@ pub(crate) fn check_motion(motion: &RobotMotion, model: &mjcf::Model) -> Result<
         }
     }
     Ok(())
-}
-
-/// Number of `qpos` entries of the free root (7), or 0 when the first joint is not a free
-/// joint at `qpos[0]`.
-pub(crate) fn root_nq(model: &mjcf::Model) -> usize {
-    match model.joints.first() {
-        Some(j) if j.kind == mjcf::JointType::Free && j.qpos_adr == 0 => 7,
-        _ => 0,
-    }
-}
-
-/// Root position and w-first orientation of one frame: the free joint's `qpos`, or the world
-/// pose of the first body for a fixed-base model.
-pub(crate) fn root_pose(
-    motion: &RobotMotion,
-    model: &mjcf::Model,
-    poses: &BodyPoses,
-    frame: usize,
-) -> ([f64; 3], [f64; 4]) {
-    if root_nq(model) == 7 {
-        match motion.frame(frame) {
-            &[x, y, z, w, i, j, k, ..] => ([x, y, z], [w, i, j, k]),
-            _ => ([0.0; 3], [1.0, 0.0, 0.0, 0.0]),
-        }
-    } else {
-        let p = poses.pos(frame, 0);
-        let q = poses.quat(frame, 0);
-        ([p.x, p.y, p.z], [q.w, q.i, q.j, q.k])
-    }
 }
 
 static TEMP_COUNTER: AtomicUsize = AtomicUsize::new(0);
@@ -256,12 +213,6 @@ mod tests {
         assert_eq!(Format::from_path(Path::new("b.json")), Some(Format::Json));
         assert_eq!(Format::from_path(Path::new("b.bvh")), None);
         assert_eq!(Format::from_path(Path::new("npz")), None);
-    }
-
-    #[test]
-    fn xyzw_moves_w_last() {
-        assert_eq!(xyzw_from_wxyz([1.0, 2.0, 3.0, 4.0]), [2.0, 3.0, 4.0, 1.0]);
-        assert_eq!(wxyz_from_xyzw(xyzw_from_wxyz([1.0, 2.0, 3.0, 4.0])), [1.0, 2.0, 3.0, 4.0]);
     }
 
     #[test]

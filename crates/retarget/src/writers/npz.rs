@@ -10,8 +10,10 @@ use std::path::Path;
 use ::npz::{Array, Npz};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use super::{angular_velocity, body_poses, gradient_rows, root_nq, Error};
+use super::derived::{angular_velocity, body_poses, gradient_rows};
+use super::root::root_nq;
 use crate::motion::{FootContacts, RobotMotion, TrackedTargets};
+use crate::Error;
 
 /// The arrays of a motion's `.npz`, in file order (see [`super::write_motion`]).
 pub(crate) fn motion_arrays(

@@ -15,8 +15,10 @@
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
-use super::{body_poses, root_nq, root_pose, xyzw_from_wxyz, Error};
+use super::derived::body_poses;
+use super::root::{root_nq, root_pose, xyzw_from_wxyz};
 use crate::motion::RobotMotion;
+use crate::Error;
 
 const PROTO: u8 = 0x80;
 const EMPTY_DICT: u8 = b'}';

@@ -20,8 +20,8 @@ use std::path::Path;
 use ::npz::{Array, Npz};
 
 use super::npz::{read_contacts, read_targets};
+use super::root::{root_nq, wxyz_from_xyzw};
 use super::unpickle;
-use super::{root_nq, wxyz_from_xyzw};
 use crate::motion::RobotMotion;
 use crate::Error;
 
