@@ -46,7 +46,7 @@ pub struct DynamicsOptions {
 
 impl Default for DynamicsOptions {
     fn default() -> Self {
-        DynamicsOptions { weight: 1000.0, contact_height: 0.01, friction: 0.8, cone_edges: 8 }
+        DynamicsOptions { weight: 300.0, contact_height: 0.01, friction: 0.8, cone_edges: 8 }
     }
 }
 
