@@ -19,7 +19,7 @@
 // below `T`.
 #![allow(clippy::indexing_slicing)]
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixView, DVector};
 
 /// The system: per frame its diagonal block and its blocks towards the frame before and the
 /// one before that (`A_{t,t−1}`, `A_{t,t−2}`; zero for the first frames), and the right-hand
@@ -150,23 +150,23 @@ impl Banded {
         for t in 0..self.frames {
             if t >= 2 {
                 // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ
-                self.scratch.gemm(1.0, &self.sub2[t], &self.inverse[t - 2].transpose(), 0.0);
+                gemm_abt(&mut self.scratch, 1.0, &self.sub2[t], &self.inverse[t - 2], 0.0);
                 self.sub2[t].copy_from(&self.scratch);
                 // A_{t,t−1} −= L_{t,t−2} L_{t−1,t−2}ᵀ
                 let (head, tail) = self.sub1.split_at_mut(t);
-                tail[0].gemm(-1.0, &self.sub2[t], &head[t - 1].transpose(), 1.0);
+                gemm_abt(&mut tail[0], -1.0, &self.sub2[t], &head[t - 1], 1.0);
             }
             if t >= 1 {
-                self.scratch.gemm(1.0, &self.sub1[t], &self.inverse[t - 1].transpose(), 0.0);
+                gemm_abt(&mut self.scratch, 1.0, &self.sub1[t], &self.inverse[t - 1], 0.0);
                 self.sub1[t].copy_from(&self.scratch);
             }
             let (s1, s2) = (&self.sub1[t], &self.sub2[t]);
             let d = &mut self.diag[t];
             if t >= 1 {
-                d.gemm(-1.0, s1, &s1.transpose(), 1.0);
+                gemm_abt(d, -1.0, s1, s1, 1.0);
             }
             if t >= 2 {
-                d.gemm(-1.0, s2, &s2.transpose(), 1.0);
+                gemm_abt(d, -1.0, s2, s2, 1.0);
             }
             cholesky_in_place(d).map_err(|()| NotPositiveDefinite { frame: t })?;
             lower_inverse(d, &mut self.inverse[t]);
@@ -205,6 +205,14 @@ impl Banded {
             self.rhs.rows_mut(t * n, n).copy_from(&y);
         }
     }
+}
+
+/// `c = β c + α a bᵀ` through nalgebra's `gemm` with `bᵀ` a view of `b`, its strides
+/// swapped: the product `b.transpose()` would give (matrixmultiply packs the same numbers),
+/// without allocating and copying the transpose.
+fn gemm_abt(c: &mut DMatrix<f64>, alpha: f64, a: &DMatrix<f64>, b: &DMatrix<f64>, beta: f64) {
+    let bt = DMatrixView::from_slice_with_strides(b.as_slice(), b.ncols(), b.nrows(), b.nrows(), 1);
+    c.gemm(alpha, a, &bt, beta);
 }
 
 /// The Cholesky factor of the symmetric `a` (its lower triangle read) in place: `a = L Lᵀ`,
