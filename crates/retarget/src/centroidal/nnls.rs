@@ -32,14 +32,27 @@ pub(crate) fn nnls(cols: &[Column], b: &Column, x: &mut Vec<f64>) -> Column {
     let mut passive: Vec<usize> = Vec::with_capacity(ROWS);
     let mut blocked = vec![false; n];
     let mut r = *b;
+    // The columns by rows, for the gradient (`by_rows[i n + j]`: row i of column j).
+    let mut by_rows = Vec::with_capacity(ROWS * n);
+    for i in 0..ROWS {
+        by_rows.extend(cols.iter().map(|c| c[i]));
+    }
+    let mut w = vec![0.0; n];
     // Lawson and Hanson bound the outer loop by 3n in their implementation.
     for _ in 0..3 * n.max(1) {
-        // The most promising column outside the passive set (gradient w = Aᵀ r).
-        let entering = (0..n)
-            .filter(|&j| !blocked[j] && !passive.contains(&j))
-            .map(|j| (j, dot(&cols[j], &r)))
-            .filter(|&(_, w)| w > tol)
-            .max_by(|a, b| a.1.total_cmp(&b.1));
+        // The most promising column outside the passive set (gradient w = Aᵀ r; the last
+        // of equal ones, as `max_by`).
+        gradient(&by_rows, &r, &mut w);
+        let mut entering: Option<(usize, f64)> = None;
+        for (j, &wj) in w.iter().enumerate() {
+            if wj > tol
+                && !blocked[j]
+                && entering.is_none_or(|(_, best)| wj.total_cmp(&best).is_ge())
+                && !passive.contains(&j)
+            {
+                entering = Some((j, wj));
+            }
+        }
         let Some((j, _)) = entering else { break };
         passive.push(j);
         let mut z = [0.0; ROWS];
@@ -87,6 +100,19 @@ pub(crate) fn nnls(cols: &[Column], b: &Column, x: &mut Vec<f64>) -> Column {
         blocked.iter_mut().for_each(|b| *b = false);
     }
     r
+}
+
+/// `w = Aᵀ r` from `A`'s rows (`by_rows`, `ROWS × n`): each entry [`dot`]'s sum, in its
+/// order (`p₀ + p₁ + … + p₅`), the columns side by side (vectorised across them).
+fn gradient(by_rows: &[f64], r: &Column, w: &mut [f64]) {
+    let n = w.len();
+    let mut rows = by_rows.chunks_exact(n.max(1));
+    let mut row = || rows.next().unwrap_or_default();
+    let (a, b, c, d, e, f) = (row(), row(), row(), row(), row(), row());
+    let columns = a.iter().zip(b).zip(c).zip(d).zip(e).zip(f);
+    for (wj, (((((a, b), c), d), e), f)) in w.iter_mut().zip(columns) {
+        *wj = a * r[0] + b * r[1] + c * r[2] + d * r[3] + e * r[4] + f * r[5];
+    }
 }
 
 /// The unconstrained least squares on the passive columns, through the normal equations
