@@ -245,7 +245,15 @@ impl BoxQp {
         self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
         self.fixed.clear();
         self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
-        self.chol.copy_from_slice(&self.h);
+        // Only the entries the factorisation and the solves read: each row's diagonal and
+        // its chain (the rest of a row stays whatever it held).
+        for (k, runs) in self.chain_runs.iter().enumerate() {
+            let row = k * n;
+            self.chol[row + k] = self.h[row + k];
+            for &(lo, hi) in runs {
+                self.chol[row + lo..=row + hi].copy_from_slice(&self.h[row + lo..=row + hi]);
+            }
+        }
         for i in 0..n {
             self.y[i] = match (self.fixed.is_empty(), self.state[i]) {
                 (true, _) => -self.c[i],
