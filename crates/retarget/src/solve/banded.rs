@@ -38,6 +38,8 @@ pub struct Banded {
     pub rhs: DVector<f64>,
     /// `L_{t,t}⁻¹` per frame ([`Banded::factor`]).
     inverse: Vec<DMatrix<f64>>,
+    /// A product's output, swapped with the block it replaces (its old contents are never
+    /// read: the products into it do not read their output).
     scratch: DMatrix<f64>,
 }
 
@@ -151,14 +153,14 @@ impl Banded {
             if t >= 2 {
                 // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ
                 gemm_abt(&mut self.scratch, 1.0, &self.sub2[t], &self.inverse[t - 2], 0.0);
-                self.sub2[t].copy_from(&self.scratch);
+                std::mem::swap(&mut self.sub2[t], &mut self.scratch);
                 // A_{t,t−1} −= L_{t,t−2} L_{t−1,t−2}ᵀ
                 let (head, tail) = self.sub1.split_at_mut(t);
                 gemm_abt(&mut tail[0], -1.0, &self.sub2[t], &head[t - 1], 1.0);
             }
             if t >= 1 {
                 gemm_abt(&mut self.scratch, 1.0, &self.sub1[t], &self.inverse[t - 1], 0.0);
-                self.sub1[t].copy_from(&self.scratch);
+                std::mem::swap(&mut self.sub1[t], &mut self.scratch);
             }
             let (s1, s2) = (&self.sub1[t], &self.sub2[t]);
             let d = &mut self.diag[t];
