@@ -61,6 +61,23 @@ impl Data {
             dof_anchor: vec![Vector3::zeros(); model.nv],
         }
     }
+
+    /// Takes `other`'s results (a workspace of the same model) into this one, reusing its
+    /// buffers: the kinematics of the same configuration, without computing them again.
+    pub fn copy_from(&mut self, other: &Data) {
+        self.xpos.clone_from(&other.xpos);
+        self.xquat.clone_from(&other.xquat);
+        self.xmat.clone_from(&other.xmat);
+        self.xanchor.clone_from(&other.xanchor);
+        self.xaxis.clone_from(&other.xaxis);
+        self.geom_xpos.clone_from(&other.geom_xpos);
+        self.geom_xmat.clone_from(&other.geom_xmat);
+        self.site_xpos.clone_from(&other.site_xpos);
+        self.site_xmat.clone_from(&other.site_xmat);
+        self.dof_axis.clone_from(&other.dof_axis);
+        self.dof_linear.clone_from(&other.dof_linear);
+        self.dof_anchor.clone_from(&other.dof_anchor);
+    }
 }
 
 /// Unit quaternion from four numbers the way `mju_normalize4` does (identity when ~0).

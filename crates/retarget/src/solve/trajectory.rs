@@ -262,6 +262,9 @@ pub(crate) struct Trajectory<'s, 'm> {
     scratch: Vec<f64>,
     /// Kinematics of the frame before the one whose grips are added ([`Trajectory::grip_terms`]).
     before: Data,
+    /// The window frame whose frame before `before` holds, when it was kept from that frame's
+    /// own terms (the solver's kinematics there) rather than computed for it.
+    before_for: Option<usize>,
 }
 
 impl<'s, 'm> Trajectory<'s, 'm> {
@@ -284,6 +287,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             states: Vec::new(),
             scratch: Vec::new(),
             before: Data::new(model),
+            before_for: None,
             solver,
         }
     }
@@ -368,6 +372,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let (nq, nv) = (model.nq, model.nv);
         let n = seq.qpos.len() / nq;
         self.banded.clear();
+        self.before_for = None;
         self.fixed_states(seq);
         for k in 0..n {
             self.frame_terms(frames, first + k, k, &seq.qpos[k * nq..(k + 1) * nq])?;
@@ -428,7 +433,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let grips = grips.to_vec();
         let model = self.solver.robot();
         let nv = model.nv;
-        model.kinematics(before, &mut self.before);
+        if self.before_for != Some(k) {
+            model.kinematics(before, &mut self.before);
+        }
         let data = self.solver.data();
         let half = slip * self.dt;
         let slack = self.options.active_slack;
@@ -459,6 +466,10 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                 self.banded.add_penalty(k, &now, before, -e, self.options.active_penalty);
             }
         }
+        // A gripped frame's next is most often gripped too: its frame before is this one,
+        // whose kinematics the solver holds now.
+        self.before.copy_from(self.solver.data());
+        self.before_for = Some(k + 1);
     }
 
     /// The dynamics term's states of the fixed frames (the solver's kinematics are moved).
