@@ -430,7 +430,6 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         if !grips.iter().any(|g| g.from.is_some()) {
             return;
         }
-        let grips = grips.to_vec();
         let model = self.solver.robot();
         let nv = model.nv;
         if self.before_for != Some(k) {
