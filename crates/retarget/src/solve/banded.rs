@@ -109,30 +109,15 @@ impl Banded {
     pub fn add_penalty(&mut self, t: usize, a: &[f64], c: Option<&[f64]>, b: f64, rho: f64) {
         let nz = |v: &[f64]| (0..v.len()).filter(|&d| v[d] != 0.0).collect::<Vec<_>>();
         let ia = nz(a);
-        let block = &mut self.diag[t];
-        for &i in &ia {
-            for &j in &ia {
-                block[(i, j)] += rho * a[i] * a[j];
-            }
-        }
+        add_outer(&mut self.diag[t], rho, (a, &ia), (a, &ia));
         let mut rhs = self.rhs_mut(t);
         for &i in &ia {
             rhs[i] += rho * a[i] * b;
         }
         let Some(c) = c else { return };
         let ic = nz(c);
-        let block = &mut self.diag[t - 1];
-        for &i in &ic {
-            for &j in &ic {
-                block[(i, j)] += rho * c[i] * c[j];
-            }
-        }
-        let block = &mut self.sub1[t];
-        for &i in &ia {
-            for &j in &ic {
-                block[(i, j)] -= rho * a[i] * c[j];
-            }
-        }
+        add_outer(&mut self.diag[t - 1], rho, (c, &ic), (c, &ic));
+        add_outer(&mut self.sub1[t], -rho, (a, &ia), (c, &ic));
         let mut rhs = self.rhs_mut(t - 1);
         for &i in &ic {
             rhs[i] -= rho * c[i] * b;
@@ -205,6 +190,20 @@ impl Banded {
             }
             y.gemv_tr(1.0, &self.inverse[t], &b, 0.0);
             self.rhs.rows_mut(t * n, n).copy_from(&y);
+        }
+    }
+}
+
+/// `block += s u vᵀ` over the non-zero entries of `u` and `v` (each with their indices).
+fn add_outer(
+    block: &mut DMatrix<f64>,
+    s: f64,
+    (u, iu): (&[f64], &[usize]),
+    (v, iv): (&[f64], &[usize]),
+) {
+    for &i in iu {
+        for &j in iv {
+            block[(i, j)] += s * u[i] * v[j];
         }
     }
 }
