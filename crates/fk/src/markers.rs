@@ -36,8 +36,15 @@ pub enum MarkerError {
     NoFrames,
     #[error("frame {frame} has {got} points, expected {expected}")]
     Shape { frame: usize, got: usize, expected: usize },
-    #[error("invalid {name} = {value}: must be a positive finite number")]
-    InvalidOption { name: &'static str, value: f64 },
+    /// A marker config's `metres_per_unit` that is not a positive finite number.
+    #[error("metres_per_unit = {0}: must be a positive finite number")]
+    BadUnit(f64),
+    /// A point rate (frames per second) that is not a positive finite number.
+    #[error("point rate {0}: must be a positive finite number of frames per second")]
+    BadRate(f64),
+    /// Height landmarks (`top` or `bottom` markers) none of which is seen in any frame.
+    #[error("none of the height markers {} is seen in any frame", .0.join(", "))]
+    HeightNeverSeen(Vec<String>),
     #[error("body `{body}`, frame {frame}: frame markers are collinear or coincide")]
     DegenerateFrame { body: String, frame: usize },
     /// A marker absurdly far from the origin (more than [`crate::MAX_DISTANCE`] in metres).
@@ -71,7 +78,7 @@ fn to_world(
     axes: &UnitQuaternion<f64>,
 ) -> Result<Vec<Vec<Option<Vector3<f64>>>>, MarkerError> {
     if !(metres_per_unit.is_finite() && metres_per_unit > 0.0) {
-        return Err(MarkerError::InvalidOption { name: "metres_per_unit", value: metres_per_unit });
+        return Err(MarkerError::BadUnit(metres_per_unit));
     }
     frames
         .iter()
@@ -149,7 +156,7 @@ pub fn marker_motion(
     bodies: &[MarkerBody],
 ) -> Result<HumanMotion, MarkerError> {
     if !(fps.is_finite() && fps > 0.0) {
-        return Err(MarkerError::InvalidOption { name: "fps", value: fps });
+        return Err(MarkerError::BadRate(fps));
     }
     if frames.is_empty() {
         return Err(MarkerError::NoFrames);
@@ -231,8 +238,8 @@ pub fn triad(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>) -> Option<Uni
 
 /// Height of landmark markers above the floor: the median over frames of the highest `top`
 /// marker, minus the lowest `bottom` marker over the clip (metres, after the axis rotation).
-/// The caller turns it into a stature (e.g. ASIS height ≈ 0.555 × stature). `None` when
-/// either set is never seen.
+/// The caller turns it into a stature (e.g. ASIS height ≈ 0.555 × stature).
+/// [`MarkerError::HeightNeverSeen`] when either set is never seen.
 pub fn marker_height(
     labels: &[String],
     frames: &[Vec<Option<[f64; 3]>>],
@@ -240,8 +247,10 @@ pub fn marker_height(
     axes: &UnitQuaternion<f64>,
     top: &[String],
     bottom: &[String],
-) -> Result<Option<f64>, MarkerError> {
+) -> Result<f64, MarkerError> {
     let world = to_world(frames, labels, metres_per_unit, axes)?;
+    let never_seen = |set: &[String]| MarkerError::HeightNeverSeen(set.to_vec());
+    let (top_names, bottom_names) = (top, bottom);
     let top: Vec<usize> =
         top.iter().map(|m| find(labels, "height", m)).collect::<Result<_, _>>()?;
     let bottom: Vec<usize> =
@@ -261,12 +270,9 @@ pub fn marker_height(
                 .reduce(f64::min)
         })
         .reduce(f64::min);
-    let Some(floor) = floor else { return Ok(None) };
-    if tops.is_empty() {
-        return Ok(None);
-    }
+    let floor = floor.ok_or_else(|| never_seen(bottom_names))?;
     tops.sort_by(f64::total_cmp);
-    Ok(tops.get(tops.len() / 2).map(|top| top - floor))
+    tops.get(tops.len() / 2).map(|top| top - floor).ok_or_else(|| never_seen(top_names))
 }
 
 #[cfg(test)]

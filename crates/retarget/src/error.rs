@@ -52,10 +52,53 @@ pub enum Error {
         #[source]
         source: Box<Error>,
     },
-    /// An option, argument or call that does not fit (the robot, the model, the clip or the
-    /// state of a stream); the message says which and why.
-    #[error("invalid option: {0}")]
-    InvalidOption(String),
+    /// An option value out of its range: `name` the option, `expected` what it takes.
+    #[error("invalid option {name} = {value}: expected {expected}")]
+    InvalidOption { name: String, value: f64, expected: &'static str },
+    /// A config bound to no body names (role-named: `retarget robot init` without a
+    /// skeleton) where a motion or a streamed frame needs one naming its bodies.
+    #[error(
+        "config {config} is role-named: it is bound to a BVH skeleton (retarget_bvh); a motion \
+         or frame needs a config naming its bodies"
+    )]
+    RoleNamedConfig { config: String },
+    /// A motion or a stream on a robot that is not shipped, without a config given.
+    #[error("robot {robot} is not a shipped robot: give its IK config (with_config)")]
+    NoConfig { robot: String },
+    /// A file to retarget whose extension names no motion format we read.
+    #[error("{}: not a motion file we retarget (expected .bvh or .fbx)", path.display())]
+    UnknownInput { path: PathBuf },
+    /// The thread pool of a parallel run could not be started.
+    #[error("cannot start a thread pool: {0}")]
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+    /// A clip with fewer frames than retargeting needs; `note` says what took them.
+    #[error("too few frames to retarget: {frames}, at least {needed} needed{note}")]
+    TooFewFrames { frames: usize, needed: usize, note: &'static str },
+    /// A subject height that is missing or not a positive number of metres; `why` says
+    /// which, and where it came from.
+    #[error("no usable subject height: {why}")]
+    SubjectHeight { why: String },
+    /// A robot in which neither body names nor the robot recogniser find two feet.
+    #[error(
+        "cannot find the two foot bodies by name (ankle/foot, left/right) nor by recognising \
+         the robot ({reason}): name them"
+    )]
+    NoFeet { reason: String },
+    /// A body name (a report option's foot, a motion's tracked target) the robot model lacks.
+    #[error("no body named \"{name}\" in the robot model")]
+    NoSuchBody { name: String },
+    /// A robot model whose masses are not known (the dynamics check needs them).
+    #[error("the robot model's masses are not known: {0}")]
+    NoMasses(String),
+    /// A body id handed to the solver (a task's, a grip's) that is not a body of its model.
+    #[error("{what}: body id {body} is not a body of the model")]
+    NotABody { what: &'static str, body: usize },
+    /// Values handed to the solver that do not fit its model or its tasks in number.
+    #[error("{what}: {got} values, expected {expected}")]
+    WrongLength { what: &'static str, got: usize, expected: usize },
+    /// Values handed to the solver (a configuration, an objective term) not all finite.
+    #[error("{what}: a value is not finite")]
+    NotFinite { what: &'static str },
     /// Human forward kinematics failed (bad BVH content, NaN in the motion, ...).
     #[error(transparent)]
     Fk(#[from] fk::Error),

@@ -274,10 +274,7 @@ impl<'m> Solver<'m> {
             let mut tasks = Vec::with_capacity(stage.len());
             for spec in stage {
                 if spec.body == 0 || spec.body >= model.nbody() {
-                    return Err(Error::InvalidOption(format!(
-                        "task body id {} is not a body of the model",
-                        spec.body
-                    )));
+                    return Err(Error::NotABody { what: "task", body: spec.body });
                 }
                 if !tracked.iter().any(|(b, _)| *b == spec.body) {
                     tracked.push((spec.body, spec.target));
@@ -376,13 +373,17 @@ impl<'m> Solver<'m> {
     /// Per-joint speed limits (indexed like `Model::joints`; rad/s or m/s), held as hard
     /// bounds `|q − q_previous frame| ≤ limit · dt` on hinge and slide joints.
     pub fn set_speed_limits(&mut self, per_joint: &[Option<f64>]) -> Result<(), Error> {
-        if per_joint.len() != self.model.joints.len()
-            || per_joint.iter().flatten().any(|v| !(v.is_finite() && *v > 0.0))
-        {
-            return Err(Error::InvalidOption(format!(
-                "speed limits must be {} positive numbers or none",
-                self.model.joints.len()
-            )));
+        let joints = &self.model.joints;
+        same_len("speed limits (one per joint)", per_joint.len(), joints.len())?;
+        let bad = joints.iter().zip(per_joint).find_map(|(joint, limit)| {
+            limit.filter(|v| !(v.is_finite() && *v > 0.0)).map(|v| (joint, v))
+        });
+        if let Some((joint, value)) = bad {
+            return Err(Error::InvalidOption {
+                name: format!("speed limit of joint {}", joint.name),
+                value,
+                expected: "a positive speed or none",
+            });
         }
         for (joint, limit) in self.model.joints.iter().zip(per_joint) {
             if matches!(joint.kind, JointType::Hinge | JointType::Slide) {
@@ -400,7 +401,7 @@ impl<'m> Solver<'m> {
     /// (`from`: none, the first frame of a stance) is free in its frame.
     pub fn set_grips(&mut self, grips: &[GripPoint], slip_speed: f64) -> Result<(), Error> {
         if let Some(g) = grips.iter().find(|g| g.body >= self.model.bodies.len()) {
-            return Err(Error::InvalidOption(format!("grip body {} is not a body", g.body)));
+            return Err(Error::NotABody { what: "grip", body: g.body });
         }
         if self.grips.as_slice() != grips || self.slip_speed != slip_speed {
             self.grips.clear();
@@ -444,7 +445,7 @@ impl<'m> Solver<'m> {
     /// The point tasks of the next frames (replacing the previous ones; bodies must exist).
     pub fn set_point_tasks(&mut self, tasks: &[PointTask]) -> Result<(), Error> {
         if let Some(t) = tasks.iter().find(|t| t.body == 0 || t.body >= self.model.nbody()) {
-            return Err(Error::InvalidOption(format!("point task body {} is not a body", t.body)));
+            return Err(Error::NotABody { what: "point task", body: t.body });
         }
         self.point_tasks.clear();
         self.point_tasks.extend_from_slice(tasks);
@@ -491,7 +492,7 @@ impl<'m> Solver<'m> {
     /// specs' `target`; `dt` (seconds per frame) is used by `max_joint_speed` only.
     ///
     /// # Errors
-    /// [`Error::InvalidOption`] when `targets` is shorter than the task specs' largest
+    /// [`Error::WrongLength`] when `targets` is shorter than the task specs' largest
     /// `target` slot.
     pub fn solve_frame(&mut self, targets: &[Pose], dt: f64) -> Result<FrameDiagnostics, Error> {
         self.check_targets(targets)?;
@@ -773,11 +774,9 @@ impl<'m> Solver<'m> {
 
     /// `qpos` is a configuration of this model: `nq` finite numbers.
     fn check_qpos(&self, qpos: &[f64]) -> Result<(), Error> {
-        if qpos.len() != self.model.nq || qpos.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "qpos must be {} finite numbers",
-                self.model.nq
-            )));
+        same_len("qpos", qpos.len(), self.model.nq)?;
+        if qpos.iter().any(|v| !v.is_finite()) {
+            return Err(Error::NotFinite { what: "qpos" });
         }
         Ok(())
     }
@@ -786,10 +785,8 @@ impl<'m> Solver<'m> {
     fn check_targets(&self, targets: &[Pose]) -> Result<(), Error> {
         let needed = self.stages.iter().flatten().map(|t| t.spec.target + 1).max().unwrap_or(0);
         if targets.len() < needed {
-            return Err(Error::InvalidOption(format!(
-                "the tasks need {needed} target poses, {} were given",
-                targets.len()
-            )));
+            let got = targets.len();
+            return Err(Error::WrongLength { what: "target poses", got, expected: needed });
         }
         Ok(())
     }
@@ -817,19 +814,35 @@ impl<'m> Solver<'m> {
     }
 }
 
-fn check_options(o: &SolverOptions) -> Result<(), Error> {
-    let ok = o.damping.is_finite()
-        && o.damping > 0.0
-        && o.lm_damping.is_finite()
-        && o.lm_damping >= 0.0
-        && o.stop_threshold.is_finite()
-        && o.limit_gain > 0.0
-        && o.limit_gain <= 1.0
-        && o.max_joint_speed.is_none_or(|v| v.is_finite() && v > 0.0);
-    if ok {
+/// [`Error::WrongLength`] unless `got == expected`.
+fn same_len(what: &'static str, got: usize, expected: usize) -> Result<(), Error> {
+    if got == expected {
         Ok(())
     } else {
-        Err(Error::InvalidOption(format!("solver options out of range: {o:?}")))
+        Err(Error::WrongLength { what, got, expected })
+    }
+}
+
+/// The first of `o`'s values out of its range, named as in [`SolverOptions`].
+fn check_options(o: &SolverOptions) -> Result<(), Error> {
+    let speed = o.max_joint_speed;
+    let checks = [
+        ("damping", o.damping, o.damping.is_finite() && o.damping > 0.0, "a positive number"),
+        ("lm_damping", o.lm_damping, o.lm_damping.is_finite() && o.lm_damping >= 0.0, "≥ 0"),
+        ("stop_threshold", o.stop_threshold, o.stop_threshold.is_finite(), "a finite number"),
+        ("limit_gain", o.limit_gain, o.limit_gain > 0.0 && o.limit_gain <= 1.0, "in (0, 1]"),
+        (
+            "max_joint_speed",
+            speed.unwrap_or(0.0),
+            speed.is_none_or(|v| v.is_finite() && v > 0.0),
+            "a positive speed or none",
+        ),
+    ];
+    match checks.into_iter().find(|(_, _, ok, _)| !ok) {
+        Some((name, value, _, expected)) => {
+            Err(Error::InvalidOption { name: format!("solver option {name}"), value, expected })
+        }
+        None => Ok(()),
     }
 }
 

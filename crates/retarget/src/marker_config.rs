@@ -142,6 +142,7 @@ impl MarkerConfig {
             at: format!("{}: `source_axes`", self.source),
             message: format!("`{}`: expected \"z-up\" or \"y-up\"", self.axes),
         })?;
+        let in_file = |e: Error| Error::InFile { path: name.to_owned(), source: Box::new(e) };
         let marker_error =
             |what: &str, source| Error::Markers { context: format!("{name}: {what}"), source };
         let human = fk::markers::marker_motion(
@@ -166,21 +167,17 @@ impl MarkerConfig {
                 &m.top,
                 &m.bottom,
             )
-            .map_err(|e| marker_error("subject height", e))?
-            .ok_or_else(|| Error::InvalidOption(format!("{name}: height markers never seen")))?;
+            .map_err(|e| marker_error("subject height", e))?;
             let fraction = m.fraction_of_stature;
             let source = format!("markers {} at {fraction} of stature", m.top.join("+"));
             SubjectHeight { metres: above / fraction, source }
         } else {
-            return Err(Error::InvalidOption(format!(
-                "{name}: give the subject height (the config has no `marker_height`)"
-            )));
+            let why = "none given, and the config has no `marker_height`".to_owned();
+            return Err(in_file(Error::SubjectHeight { why }));
         };
         if !(height.metres.is_finite() && height.metres > 0.0) {
-            return Err(Error::InvalidOption(format!(
-                "{name}: subject height {} m is not positive",
-                height.metres
-            )));
+            let why = format!("{} m ({}) is not positive", height.metres, height.source);
+            return Err(in_file(Error::SubjectHeight { why }));
         }
         Ok(MarkerMotion { human, height })
     }

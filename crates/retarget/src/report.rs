@@ -569,7 +569,7 @@ pub fn report(
 
 /// The dynamics check of every checked frame (frames 2h..T−1−2h, accelerations averaged over
 /// [`DynamicsCheckOptions::span`]; module documentation), e.g. to find the frames behind
-/// [`QualityReport::dynamics`]. An [`Error::InvalidOption`] when the model's masses are not known.
+/// [`QualityReport::dynamics`]. An [`Error::NoMasses`] when the model's masses are not known.
 pub fn dynamics_frames(
     motion: &RobotMotion,
     model: &mjcf::Model,
@@ -579,7 +579,7 @@ pub fn dynamics_frames(
     let poses = body_poses(motion, model);
     dynamics::check(motion, model, &poses, opts.ground_height, &opts.dynamics, None)
         .map(|c| c.frames)
-        .map_err(Error::InvalidOption)
+        .map_err(Error::NoMasses)
 }
 
 /// Ground penetration of every collision geom and self-collision, in one pass of FK; and per
@@ -673,7 +673,7 @@ fn named_body(model: &mjcf::Model, name: &str) -> Result<usize, Error> {
     model
         .body_id(name)
         .filter(|&b| b > 0)
-        .ok_or_else(|| Error::InvalidOption(format!("no body named \"{name}\" in the robot model")))
+        .ok_or_else(|| Error::NoSuchBody { name: name.to_owned() })
 }
 
 fn tracking(

@@ -18,13 +18,11 @@ use crate::Error;
 /// `motion` at `fps` frames per second. Joint types come from `model` (the motion's robot).
 pub fn resample(motion: &RobotMotion, model: &Model, fps: f64) -> Result<RobotMotion, Error> {
     if !(fps.is_finite() && fps > 0.0) {
-        return Err(Error::InvalidOption(format!("--fps {fps}: expected a positive rate")));
+        let name = "--fps".to_owned();
+        return Err(Error::InvalidOption { name, value: fps, expected: "a positive rate" });
     }
     if motion.nq != model.nq {
-        return Err(Error::InvalidOption(format!(
-            "motion has nq {} but the robot has nq {}",
-            motion.nq, model.nq
-        )));
+        return Err(Error::Mismatch(format!("motion nq {} but model nq {}", motion.nq, model.nq)));
     }
     let frames = motion.num_frames();
     if frames == 0 {
@@ -175,10 +173,12 @@ mod tests {
     #[test]
     fn bad_rates_and_mismatched_models_are_errors() {
         let m = motion(3, 30.0);
-        assert!(resample(&m, &model(), 0.0).is_err());
+        let err = resample(&m, &model(), 0.0).unwrap_err();
+        assert!(matches!(err, Error::InvalidOption { value: 0.0, .. }), "{err}");
         assert!(resample(&m, &model(), f64::NAN).is_err());
         let mut wrong = m.clone();
         wrong.nq = 7;
-        assert!(resample(&wrong, &model(), 30.0).is_err());
+        let err = resample(&wrong, &model(), 30.0).unwrap_err();
+        assert!(matches!(err, Error::Mismatch(_)), "{err}");
     }
 }

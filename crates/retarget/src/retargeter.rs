@@ -282,21 +282,7 @@ impl Retargeter {
 
     /// The config of motions and frames: the given one, else the shipped robot's tuned one.
     pub fn motion_config(&self) -> Result<&IkConfig, Error> {
-        match (&self.given, &self.tuned) {
-            (Some(given), _) if crate::derive::is_role_named(given) => {
-                Err(Error::InvalidOption(format!(
-                    "config {} is role-named: it is bound to a BVH skeleton \
-                     (retarget_bvh); a motion or frame needs a config naming its bodies",
-                    given.source
-                )))
-            }
-            (Some(given), _) => Ok(given),
-            (None, Some(tuned)) => Ok(tuned),
-            (None, None) => Err(Error::InvalidOption(format!(
-                "robot {} is not a shipped robot: give its IK config (with_config)",
-                self.label
-            ))),
-        }
+        motion_config(self.given.as_ref(), self.tuned.as_ref(), &self.label)
     }
 
     /// Retargets a clip: FK of the skeleton (up axis, units and height inferred), the config
@@ -458,28 +444,20 @@ impl Retargeter {
     /// frames must hold them (in any order; extra bodies are ignored).
     pub fn step(&mut self, frame: &HumanFrame) -> Result<&[f64], Error> {
         let slot = self.stream.get_mut().unwrap_or_else(PoisonError::into_inner);
-        if slot.is_none() {
-            let config = match (&self.given, &self.tuned) {
-                (Some(g), _) if !crate::derive::is_role_named(g) => g,
-                (None, Some(t)) => t,
-                _ => {
-                    // The same message as motion_config's, without borrowing all of self.
-                    return Err(Error::InvalidOption(format!(
-                        "robot {}: streaming needs a config naming the frame's bodies \
-                         (with_config) or a shipped robot's tuned config",
-                        self.label
-                    )));
-                }
-            };
-            *slot = Some(Stream::new(
-                Arc::clone(&self.model),
-                config,
-                &frame.body_names,
-                &self.options,
-                self.stream_fps,
-            )?);
-        }
-        let stream = slot.as_mut().ok_or_else(|| Error::InvalidOption("no stream".into()))?;
+        let stream = match slot {
+            Some(stream) => stream,
+            None => {
+                // motion_config's choice, without borrowing all of self.
+                let config = motion_config(self.given.as_ref(), self.tuned.as_ref(), &self.label)?;
+                slot.insert(Stream::new(
+                    Arc::clone(&self.model),
+                    config,
+                    &frame.body_names,
+                    &self.options,
+                    self.stream_fps,
+                )?)
+            }
+        };
         stream.step(frame)
     }
 
@@ -515,10 +493,7 @@ impl Retargeter {
         threads: usize,
     ) -> Result<Vec<Result<FileResult, Error>>, Error> {
         use rayon::prelude::*;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| Error::InvalidOption(format!("thread pool: {e}")))?;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         Ok(pool.install(|| {
             pairs.par_iter().map(|(input, output)| self.retarget_file(input, output)).collect()
         }))
@@ -534,7 +509,7 @@ impl Retargeter {
         } else if is("fbx") {
             self.retarget_fbx_file(input, None)?
         } else {
-            return Err(in_file(Error::InvalidOption("not a .bvh or .fbx file".to_owned())));
+            return Err(Error::UnknownInput { path: input.to_path_buf() });
         };
         self.write(&motion, output, None)?;
         Ok(FileResult {
@@ -604,6 +579,23 @@ struct Stream {
     last: Option<FrameDiagnostics>,
 }
 
+/// The config of motions and frames ([`Retargeter::motion_config`]): the given one unless
+/// it is role-named, else the shipped robot's tuned one.
+fn motion_config<'c>(
+    given: Option<&'c IkConfig>,
+    tuned: Option<&'c IkConfig>,
+    robot: &str,
+) -> Result<&'c IkConfig, Error> {
+    match (given, tuned) {
+        (Some(given), _) if crate::derive::is_role_named(given) => {
+            Err(Error::RoleNamedConfig { config: given.source.clone() })
+        }
+        (Some(given), _) => Ok(given),
+        (None, Some(tuned)) => Ok(tuned),
+        (None, None) => Err(Error::NoConfig { robot: robot.to_owned() }),
+    }
+}
+
 impl Stream {
     fn new(
         model: Arc<Model>,
@@ -613,9 +605,11 @@ impl Stream {
         fps: f64,
     ) -> Result<Stream, Error> {
         if !(fps.is_finite() && fps > 0.0) {
-            return Err(Error::InvalidOption(format!(
-                "stream fps {fps}: expected a positive rate"
-            )));
+            return Err(Error::InvalidOption {
+                name: "stream fps".to_owned(),
+                value: fps,
+                expected: "a positive rate",
+            });
         }
         let height = SubjectHeight::of_motion(options.human_height, config);
         config.validate(&model, names)?;

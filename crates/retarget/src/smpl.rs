@@ -133,9 +133,8 @@ impl Retargeter {
         // The source's feet for the contact phases (both modes write them), by role.
         let roles = crate::solve::source_roles(&options.fk.roles, clip.roles());
         if human.num_frames == 0 {
-            return Err(in_file(Error::InvalidOption(
-                "too few frames to retarget (GMR's path skips the first resampled frame)".into(),
-            )));
+            let note = if gmr { " (GMR's path skips the first resampled frame)" } else { "" };
+            return Err(in_file(Error::TooFewFrames { frames: 0, needed: 1, note }));
         }
         let (robot, mut diag) = crate::solve::solve_clip(
             &human,

@@ -56,9 +56,8 @@ impl TargetMap {
         subject_height: f64,
     ) -> Result<TargetMap, Error> {
         if !(subject_height.is_finite() && subject_height > 0.0) {
-            return Err(Error::InvalidOption(format!(
-                "subject height must be a positive number of metres, got {subject_height}"
-            )));
+            let why = format!("{subject_height} m is not a positive number of metres");
+            return Err(Error::SubjectHeight { why });
         }
         let ratio = subject_height / config.human_height_assumption;
         let ground = Vector3::new(0.0, 0.0, config.ground_height);

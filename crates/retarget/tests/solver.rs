@@ -125,6 +125,31 @@ fn out_of_range_target_stops_at_the_limit() {
     assert!(last.unwrap().at_limit.contains(&elbow));
 }
 
+/// What a solver is handed that does not fit it: each refusal names the value.
+#[test]
+fn the_solvers_refusals_name_what_does_not_fit() {
+    use retarget::Error;
+    let model = g1();
+    let pelvis = model.body_id("pelvis").unwrap();
+    let task = |body| vec![TaskSpec { body, target: 0, pos_weight: 1.0, rot_weight: 1.0 }];
+    let mut o = SolverOptions::default();
+    o.limit_gain = 1.5;
+    let err = Solver::new(&model, &[task(pelvis)], o).unwrap_err();
+    let text = err.to_string();
+    assert!(matches!(err, Error::InvalidOption { value: 1.5, .. }), "{text}");
+    assert!(text.contains("limit_gain"), "{text}");
+    let err = Solver::new(&model, &[task(model.nbody())], SolverOptions::default()).unwrap_err();
+    assert!(matches!(err, Error::NotABody { what: "task", .. }), "{err}");
+    let mut solver = Solver::new(&model, &[task(pelvis)], SolverOptions::default()).unwrap();
+    let err = solver.set_qpos(&[0.0; 3]).unwrap_err();
+    assert!(matches!(err, Error::WrongLength { what: "qpos", got: 3, .. }), "{err}");
+    let mut nan = model.qpos0.clone();
+    nan[7] = f64::NAN;
+    assert!(matches!(solver.set_qpos(&nan), Err(Error::NotFinite { what: "qpos" })));
+    let err = solver.solve_frame(&[], 1.0 / 30.0).unwrap_err();
+    assert!(matches!(err, Error::WrongLength { got: 0, expected: 1, .. }), "{err}");
+}
+
 #[test]
 fn max_joint_speed_bounds_every_frame() {
     let model = g1();

@@ -60,9 +60,6 @@ pub fn detect_feet(model: &Model) -> Result<[usize; 2], Error> {
         (Some(l), Some(r), Err(_)) if l != r => Ok([l, r]),
         // Names say nothing: the robot recogniser's feet (tree and geometry).
         (_, _, Ok(found)) => Ok(found),
-        (_, _, Err(e)) => Err(Error::InvalidOption(format!(
-            "cannot find the two foot bodies by name (ankle/foot, left/right) nor by \
-             recognising the robot ({e}): name them"
-        ))),
+        (_, _, Err(e)) => Err(Error::NoFeet { reason: e.to_string() }),
     }
 }

@@ -20,10 +20,10 @@ impl<'m> Solver<'m> {
             self.extra_c.clear();
             return Ok(());
         }
-        if h.len() != nv * nv || c.len() != nv || h.iter().chain(c).any(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption(format!(
-                "an extra objective needs {nv} × {nv} and {nv} finite numbers"
-            )));
+        same_len("extra objective H", h.len(), nv * nv)?;
+        same_len("extra objective c", c.len(), nv)?;
+        if h.iter().chain(c).any(|v| !v.is_finite()) {
+            return Err(Error::NotFinite { what: "extra objective" });
         }
         self.extra_h.clear();
         self.extra_h.extend_from_slice(h);

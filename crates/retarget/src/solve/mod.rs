@@ -90,9 +90,9 @@ pub fn retarget_motion(
     config: &IkConfig,
     options: &RetargetOptions,
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
-    let metres = options
-        .human_height
-        .ok_or_else(|| Error::InvalidOption("the subject height is required".to_owned()))?;
+    let metres = options.human_height.ok_or_else(|| Error::SubjectHeight {
+        why: "none given (retarget_motion reads RetargetOptions::human_height)".to_owned(),
+    })?;
     let height = SubjectHeight::given(metres);
     solve_clip(human, model, config, options, &height, &options.fk.roles)
 }

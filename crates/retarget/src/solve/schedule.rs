@@ -37,7 +37,8 @@ impl Default for ChunkOptions {
 /// its seam.
 pub(super) fn solve_chunks(prepared: &Prepared<'_>, chunk: ChunkOptions) -> Result<Solved, Error> {
     if chunk.frames == 0 {
-        return Err(Error::InvalidOption("chunks need at least one frame".to_owned()));
+        let name = "chunk frames".to_owned();
+        return Err(Error::InvalidOption { name, value: 0.0, expected: "at least one frame" });
     }
     let model = prepared.model;
     let n = prepared.num_frames();
