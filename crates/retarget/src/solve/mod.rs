@@ -33,7 +33,6 @@ mod treadmill;
 mod windows;
 
 use std::collections::BTreeMap;
-use std::ops::Range;
 use std::time::Instant;
 
 use bvh::Bvh;
@@ -43,21 +42,20 @@ use mjcf::Model;
 pub use dynamics_term::DynamicsOptions;
 pub(crate) use first_pass::{first_frame_dt, solve_first_frame};
 pub use options::{
-    ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode,
-    SpeedLimits, StageReport, StageValue, SubjectHeight,
+    ChunkOptions, ClipDiagnostics, Planting, PlausibleOptions, RetargetOptions, SelfCollisionMode,
+    SolveMode, SpeedLimits, StageReport, StageValue, SubjectHeight,
 };
 pub(crate) use pipeline::Pipeline;
 pub(crate) use prepare::build_solver;
 pub use prepare::task_specs;
 pub(crate) use prepare::{finite_pose, reject_divergence};
-pub use schedule::ChunkOptions;
 pub use trajectory::TrajectoryOptions;
 
 use crate::config::IkConfig;
 use crate::contact_phases::human_foot_points;
 use crate::motion::RobotMotion;
 use crate::Error;
-use prepare::{Prepared, Solved};
+use prepare::Prepared;
 
 /// Human FK of `bvh`, then [`retarget_motion`].
 pub fn retarget_bvh(
@@ -140,7 +138,7 @@ pub(crate) fn solve_clip(
     // 5 and 6. The first pass and the trajectory solve, over the schedule.
     let n = prepared.num_frames();
     let solved = match options.chunk {
-        None => solve_range(&prepared, 0..n, 0)?,
+        None => schedule::solve_range(&prepared, 0..n, 0)?,
         Some(chunk) => schedule::solve_chunks(&prepared, chunk)?,
     };
     Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
@@ -156,30 +154,4 @@ pub fn retarget_motion_chunked(
 ) -> Result<(RobotMotion, ClipDiagnostics), Error> {
     let options = RetargetOptions { chunk: Some(chunk), ..options.clone() };
     retarget_motion(human, model, config, &options)
-}
-
-/// Frames `range` of `prepared` through stages 5 and 6, from `qpos0` at `range.start −
-/// lead_in` (the lead-in's frames are solved and dropped) to a window's overlap past its end
-/// (the trajectory solve's last frames need the frames after them in view).
-pub(crate) fn solve_range(
-    prepared: &Prepared<'_>,
-    range: Range<usize>,
-    lead_in: usize,
-) -> Result<Solved, Error> {
-    let nq = prepared.model.nq;
-    let first = range.start.saturating_sub(lead_in);
-    let trajectory = prepared.pipeline.trajectory.as_ref();
-    let ahead = trajectory.map_or(0, |t| trajectory::overlap_frames(t, prepared.fps));
-    let end = (range.end + ahead).min(prepared.num_frames());
-    let mut solver = prepared.solver()?;
-    // 5. The first pass.
-    let (mut qpos, mut frames) = prepared.first_pass(&mut solver, first..end)?;
-    // 6. The trajectory solve.
-    if let (Some(options), false) = (trajectory, qpos.is_empty()) {
-        prepared.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
-    }
-    let skip = range.start - first;
-    qpos.truncate((range.end - first) * nq);
-    frames.truncate(range.end - first);
-    Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
 }

@@ -142,6 +142,20 @@ impl PlausibleOptions {
     }
 }
 
+/// How to cut a clip: chunks of `frames` frames, each preceded by `lead_in` frames of warm-up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChunkOptions {
+    pub frames: usize,
+    pub lead_in: usize,
+}
+
+impl Default for ChunkOptions {
+    /// 20 s chunks at 30 fps with a 2 s lead-in.
+    fn default() -> ChunkOptions {
+        ChunkOptions { frames: 600, lead_in: 60 }
+    }
+}
+
 /// Options of a [`crate::Retargeter`]'s solve.
 #[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
@@ -153,7 +167,7 @@ pub struct RetargetOptions {
     /// (`human_foot_points`), before the recognised ones (`solve::source_roles`).
     pub fk: FkOptions,
     /// Solve long clips as parallel chunks; `None`: one serial pass.
-    pub chunk: Option<super::ChunkOptions>,
+    pub chunk: Option<ChunkOptions>,
     /// The default solve or GMR's.
     pub mode: SolveMode,
 }

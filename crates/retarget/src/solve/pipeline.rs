@@ -2,9 +2,8 @@
 //! ([`Pipeline::new`]) into the list of enabled stages with their options, which the stages
 //! read instead of the mode.
 
-use super::reweigh::ReweighOptions;
 use super::trajectory::TrajectoryOptions;
-use super::{RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits};
+use super::{PlausibleOptions, RetargetOptions, SelfCollisionMode, SolveMode, SpeedLimits};
 use crate::contact_phases::ContactOptions;
 use crate::feet::FootPlanOptions;
 use crate::ik::SolverOptions;
@@ -99,5 +98,23 @@ impl Pipeline {
     /// GMR's solve exactly (`--gmr`): no constraint, no stage of ours.
     pub(crate) fn is_gmr(&self) -> bool {
         self.constraints.is_none()
+    }
+}
+
+/// Stage 4's tunables, [`PlausibleOptions`]' (documented there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ReweighOptions {
+    pub trunk_rotation_scale: f64,
+    pub root_position_weight_cap: f64,
+    pub pelvis_offset_range: [f64; 2],
+}
+
+impl From<&PlausibleOptions> for ReweighOptions {
+    fn from(p: &PlausibleOptions) -> ReweighOptions {
+        ReweighOptions {
+            trunk_rotation_scale: p.trunk_rotation_scale,
+            root_position_weight_cap: p.root_position_weight_cap,
+            pelvis_offset_range: p.pelvis_offset_range,
+        }
     }
 }

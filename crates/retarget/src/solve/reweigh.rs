@@ -13,14 +13,15 @@ use std::ops::Range;
 
 use mjcf::Model;
 
+use super::pipeline::ReweighOptions;
 use super::prepare::Prepared;
-use super::{PlausibleOptions, StageReport, StageValue};
+use super::{StageReport, StageValue};
 use crate::ik::TaskSpec;
 use crate::Error;
 
 impl<'a> Prepared<'a> {
     /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
-    /// ([`Prepared::pelvis_offset`], [`PlausibleOptions::pelvis_offset_range`]).
+    /// ([`Prepared::pelvis_offset`], [`crate::PlausibleOptions::pelvis_offset_range`]).
     /// Stage 4 (default solve, feet planted).
     pub(super) fn reweigh_where_planted(&mut self) -> Result<(), Error> {
         let Some(options) = self.pipeline.reweigh else { return Ok(()) };
@@ -114,24 +115,6 @@ fn report(offset: f64, share: f64) -> StageReport {
     }
 }
 
-/// Stage 4's tunables, [`PlausibleOptions`]' (documented there).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ReweighOptions {
-    pub trunk_rotation_scale: f64,
-    pub root_position_weight_cap: f64,
-    pub pelvis_offset_range: [f64; 2],
-}
-
-impl From<&PlausibleOptions> for ReweighOptions {
-    fn from(p: &PlausibleOptions) -> ReweighOptions {
-        ReweighOptions {
-            trunk_rotation_scale: p.trunk_rotation_scale,
-            root_position_weight_cap: p.root_position_weight_cap,
-            pelvis_offset_range: p.pelvis_offset_range,
-        }
-    }
-}
-
 /// Windows of a clip solved to measure how far the pelvis stands from its target
 /// ([`Prepared::pelvis_offset`]), their length (s), and the time at the start of each left
 /// out (s; the solve settles from its start pose). 30 and 5 frames at 30 fps.
@@ -142,9 +125,9 @@ const PELVIS_SETTLE_S: f64 = 1.0 / 6.0;
 /// The default solve's weights where the config pins the pelvis at a height that disagrees
 /// with the robot's legs:
 /// the config's, with the rotation weight of every task whose body is not on an arm
-/// multiplied by [`PlausibleOptions::trunk_rotation_scale`], and the position weight of the
+/// multiplied by [`crate::PlausibleOptions::trunk_rotation_scale`], and the position weight of the
 /// root's task (the task whose target is the human root, slot `root_target`) at most
-/// [`PlausibleOptions::root_position_weight_cap`] (`options`: those two); `share` (0 to 1) of each change. The arms
+/// [`crate::PlausibleOptions::root_position_weight_cap`] (`options`: those two); `share` (0 to 1) of each change. The arms
 /// are the subtrees that hang from the recognised chest towards each upper arm
 /// ([`crate::RobotRoles`]); a robot the recogniser rejects keeps its rotation weights.
 ///

@@ -1,4 +1,5 @@
-//! The schedule of stages 5 and 6: one long clip as chunks in parallel.
+//! The schedule of stages 5 and 6: a range of frames through both ([`solve_range`]: the
+//! whole clip), or one long clip as chunks in parallel ([`solve_chunks`]).
 //!
 //! The solver is sequential (each frame warm-starts from the previous one), so a long clip
 //! uses one core. Here the clip is cut into chunks of `frames` frames; each chunk is solved
@@ -12,28 +13,43 @@
 // No panics on input (issue 15); tests may (clippy.toml).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
 
+use std::ops::Range;
+
 use mjcf::Model;
 use rayon::prelude::*;
 
 use super::prepare::{Prepared, Solved};
+use super::ChunkOptions;
 use crate::Error;
 
-/// How to cut a clip: chunks of `frames` frames, each preceded by `lead_in` frames of warm-up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ChunkOptions {
-    pub frames: usize,
-    pub lead_in: usize,
-}
-
-impl Default for ChunkOptions {
-    /// 20 s chunks at 30 fps with a 2 s lead-in.
-    fn default() -> ChunkOptions {
-        ChunkOptions { frames: 600, lead_in: 60 }
+/// Frames `range` of `prepared` through stages 5 and 6, from `qpos0` at `range.start −
+/// lead_in` (the lead-in's frames are solved and dropped) to a window's overlap past its end
+/// (the trajectory solve's last frames need the frames after them in view).
+pub(super) fn solve_range(
+    prepared: &Prepared<'_>,
+    range: Range<usize>,
+    lead_in: usize,
+) -> Result<Solved, Error> {
+    let nq = prepared.model.nq;
+    let first = range.start.saturating_sub(lead_in);
+    let trajectory = prepared.pipeline.trajectory.as_ref();
+    let ahead = trajectory.map_or(0, |t| super::trajectory::overlap_frames(t, prepared.fps));
+    let end = (range.end + ahead).min(prepared.num_frames());
+    let mut solver = prepared.solver()?;
+    // 5. The first pass.
+    let (mut qpos, mut frames) = prepared.first_pass(&mut solver, first..end)?;
+    // 6. The trajectory solve.
+    if let (Some(options), false) = (trajectory, qpos.is_empty()) {
+        prepared.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
     }
+    let skip = range.start - first;
+    qpos.truncate((range.end - first) * nq);
+    frames.truncate(range.end - first);
+    Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
 }
 
 /// Frames `0..n` of `prepared` solved as chunks on rayon's current pool (stages 5 and 6 of
-/// each, [`super::solve_range`]) and stitched, each chunk's quaternions continued across
+/// each, [`solve_range`]) and stitched, each chunk's quaternions continued across
 /// its seam.
 pub(super) fn solve_chunks(prepared: &Prepared<'_>, chunk: ChunkOptions) -> Result<Solved, Error> {
     if chunk.frames == 0 {
@@ -45,9 +61,7 @@ pub(super) fn solve_chunks(prepared: &Prepared<'_>, chunk: ChunkOptions) -> Resu
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
     let parts = starts
         .par_iter()
-        .map(|&start| {
-            super::solve_range(prepared, start..(start + chunk.frames).min(n), chunk.lead_in)
-        })
+        .map(|&start| solve_range(prepared, start..(start + chunk.frames).min(n), chunk.lead_in))
         .collect::<Result<Vec<Solved>, Error>>()?;
     let mut solved =
         Solved { qpos: Vec::with_capacity(n * model.nq), frames: Vec::with_capacity(n) };
