@@ -371,7 +371,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let model = self.solver.robot();
         let (nq, nv) = (model.nq, model.nv);
         let n = seq.qpos.len() / nq;
-        self.banded.clear();
+        // (frame_terms writes each frame's diagonal block and right-hand side whole.)
+        self.banded.clear_couplings();
         self.before_for = None;
         self.fixed_states(seq);
         for k in 0..n {
@@ -563,15 +564,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         }
         // Rows at or past their bound are held: a·δ = max(b, 0) (a point on the floor stays
         // there, one below it comes up to it).
-        let rows: Vec<(Vec<f64>, f64)> = self
-            .solver
-            .constraint_rows()
-            .into_iter()
-            .filter(|(_, b)| *b > -slack)
-            .map(|(a, b)| (a.to_vec(), b.max(0.0)))
-            .collect();
-        for (a, b) in rows {
-            self.banded.add_penalty(k, &a, None, b, rho);
+        for (a, b) in self.solver.constraint_rows().into_iter().filter(|(_, b)| *b > -slack) {
+            self.banded.add_penalty(k, a, None, b.max(0.0), rho);
         }
         // Joints at a range end stay there.
         for joint in &model.joints {
