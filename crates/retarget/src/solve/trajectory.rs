@@ -434,7 +434,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let model = self.solver.robot();
         let nv = model.nv;
         if self.before_for != Some(k) {
-            model.kinematics(before, &mut self.before);
+            // (Bodies and dof frames alone: the grip reads no geom.)
+            model.body_kinematics(before, &mut self.before);
         }
         let data = self.solver.data();
         let half = slip * self.dt;
