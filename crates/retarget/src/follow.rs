@@ -171,6 +171,9 @@ fn limbs(model: &Model, roles: &RobotRoles) -> Vec<LimbSpec> {
     out
 }
 
+/// A body and its slot among the motion's targets (none: it has no target).
+type BodySlot = (usize, Option<usize>);
+
 /// The stretches of `motion` (solved on `model`, recognised as `roles`) in which a limb
 /// cannot follow; empty without tracked targets or when the motion's joints are not the
 /// model's.
@@ -184,7 +187,7 @@ pub fn blocked_limbs(model: &Model, roles: &RobotRoles, motion: &RobotMotion) ->
     let k_of = |b: usize| targets.body_names.iter().position(|n| *n == model.bodies[b].name);
     let specs = limbs(model, roles);
     // Each limb's tracked bodies and trunk as slots of the targets, looked up once.
-    let slots: Vec<(Vec<(usize, Option<usize>)>, Option<(usize, Option<usize>)>)> = specs
+    let slots: Vec<(Vec<BodySlot>, Option<BodySlot>)> = specs
         .iter()
         .map(|s| (s.tracked.iter().map(|&b| (b, k_of(b))).collect(), s.trunk.map(|b| (b, k_of(b)))))
         .collect();
