@@ -171,6 +171,9 @@ fn limbs(model: &Model, roles: &RobotRoles) -> Vec<LimbSpec> {
     out
 }
 
+/// A body and its slot among the motion's targets (none: it has no target).
+type BodySlot = (usize, Option<usize>);
+
 /// The stretches of `motion` (solved on `model`, recognised as `roles`) in which a limb
 /// cannot follow; empty without tracked targets or when the motion's joints are not the
 /// model's.
@@ -183,13 +186,19 @@ pub fn blocked_limbs(model: &Model, roles: &RobotRoles, motion: &RobotMotion) ->
     let frames = motion.num_frames();
     let k_of = |b: usize| targets.body_names.iter().position(|n| *n == model.bodies[b].name);
     let specs = limbs(model, roles);
+    // Each limb's tracked bodies and trunk as slots of the targets, looked up once.
+    let slots: Vec<(Vec<BodySlot>, Option<BodySlot>)> = specs
+        .iter()
+        .map(|s| (s.tracked.iter().map(|&b| (b, k_of(b))).collect(), s.trunk.map(|b| (b, k_of(b)))))
+        .collect();
     let mut data = Data::new(model);
     // Per limb, per frame: the joints at a bound (and which bound) and the limb's error.
     let mut per_limb: Vec<Vec<FrameState>> = vec![Vec::new(); specs.len()];
     for t in 0..frames {
         let q = motion.frame(t);
-        model.kinematics(q, &mut data);
-        for (spec, out) in specs.iter().zip(&mut per_limb) {
+        // (The bodies' poses alone: no geom is read.)
+        model.body_kinematics(q, &mut data);
+        for ((spec, (tracked, trunk)), out) in specs.iter().zip(&slots).zip(&mut per_limb) {
             let pinned: Vec<(usize, bool)> = spec
                 .joints
                 .iter()
@@ -207,17 +216,15 @@ pub fn blocked_limbs(model: &Model, roles: &RobotRoles, motion: &RobotMotion) ->
                     }
                 })
                 .collect();
-            let error = spec
-                .tracked
+            let error = tracked
                 .iter()
-                .filter_map(|&b| {
-                    let k = k_of(b)?;
-                    let target = targets.pos.get(t * targets.body_names.len() + k)?;
+                .filter_map(|&(b, k)| {
+                    let target = targets.pos.get(t * targets.body_names.len() + k?)?;
                     Some((data.xpos[b] - target).norm())
                 })
                 .fold(0.0, f64::max);
-            let trunk = spec.trunk.and_then(|b| {
-                let target = targets.quat.get(t * targets.body_names.len() + k_of(b)?)?;
+            let trunk = trunk.and_then(|(b, k)| {
+                let target = targets.quat.get(t * targets.body_names.len() + k?)?;
                 Some(data.xquat[b].angle_to(target))
             });
             out.push((pinned, error, trunk));

@@ -431,7 +431,8 @@ impl<'m> Solver<'m> {
         if dt <= 0.0 || !self.grips.iter().any(|g| g.from.is_some()) {
             return;
         }
-        self.model.kinematics(&self.previous, &mut self.previous_data);
+        // (Its bodies' poses alone: no geom is read.)
+        self.model.body_kinematics(&self.previous, &mut self.previous_data);
         let data = &self.previous_data;
         let slip = self.slip_speed;
         for g in self.grips.iter().filter(|g| g.from.is_some()) {

@@ -41,6 +41,10 @@ pub struct Banded {
     /// A product's output, swapped with the block it replaces (its old contents are never
     /// read: the products into it do not read their output).
     scratch: DMatrix<f64>,
+    /// Work buffers: the non-zero entries of a penalty's two rows ([`Banded::add_penalty`]),
+    /// a diagonal block's reciprocal pivots ([`lower_inverse`]).
+    nonzero: (Vec<usize>, Vec<usize>),
+    reciprocal: Vec<f64>,
 }
 
 /// The factorisation met a block that is not positive definite (at this frame).
@@ -62,6 +66,8 @@ impl Banded {
             rhs: DVector::zeros(n * frames),
             inverse: zeros(),
             scratch: DMatrix::zeros(n, n),
+            nonzero: (Vec::with_capacity(n), Vec::with_capacity(n)),
+            reciprocal: vec![0.0; n],
         }
     }
 
@@ -77,6 +83,15 @@ impl Banded {
             m.as_mut_slice().fill(0.0);
         }
         self.rhs.as_mut_slice().fill(0.0);
+    }
+
+    /// [`Banded::clear`] but for the diagonal blocks and the right-hand side, for a caller
+    /// that writes each frame's whole diagonal block and right-hand side before it adds to
+    /// them.
+    pub fn clear_couplings(&mut self) {
+        for m in self.sub1.iter_mut().chain(&mut self.sub2) {
+            m.as_mut_slice().fill(0.0);
+        }
     }
 
     /// `A_{t,t}`, to add a frame's own terms to (symmetric: both triangles are read).
@@ -107,19 +122,24 @@ impl Banded {
     /// Adds the penalty `½ ρ (a · x_t − c · x_{t−1} − b)²` (`rho` = ρ): a row of frame `t`
     /// alone (`c`: none), or one that couples it with the frame before.
     pub fn add_penalty(&mut self, t: usize, a: &[f64], c: Option<&[f64]>, b: f64, rho: f64) {
-        let nz = |v: &[f64]| (0..v.len()).filter(|&d| v[d] != 0.0).collect::<Vec<_>>();
-        let ia = nz(a);
-        add_outer(&mut self.diag[t], rho, (a, &ia), (a, &ia));
-        let mut rhs = self.rhs_mut(t);
-        for &i in &ia {
+        let nz = |v: &[f64], out: &mut Vec<usize>| {
+            out.clear();
+            out.extend((0..v.len()).filter(|&d| v[d] != 0.0));
+        };
+        let n = self.n;
+        let (ia, ic) = &mut self.nonzero;
+        nz(a, ia);
+        add_outer(&mut self.diag[t], rho, (a, ia), (a, ia));
+        let rhs = &mut self.rhs.as_mut_slice()[t * n..(t + 1) * n];
+        for &i in ia.iter() {
             rhs[i] += rho * a[i] * b;
         }
         let Some(c) = c else { return };
-        let ic = nz(c);
-        add_outer(&mut self.diag[t - 1], rho, (c, &ic), (c, &ic));
-        add_outer(&mut self.sub1[t], -rho, (a, &ia), (c, &ic));
-        let mut rhs = self.rhs_mut(t - 1);
-        for &i in &ic {
+        nz(c, ic);
+        add_outer(&mut self.diag[t - 1], rho, (c, ic), (c, ic));
+        add_outer(&mut self.sub1[t], -rho, (a, ia), (c, ic));
+        let rhs = &mut self.rhs.as_mut_slice()[(t - 1) * n..t * n];
+        for &i in ic.iter() {
             rhs[i] -= rho * c[i] * b;
         }
     }
@@ -156,7 +176,7 @@ impl Banded {
                 gemm_abt(d, -1.0, s2, s2, 1.0);
             }
             cholesky_in_place(d).map_err(|()| NotPositiveDefinite { frame: t })?;
-            lower_inverse(d, &mut self.inverse[t]);
+            lower_inverse(d, &mut self.inverse[t], &mut self.reciprocal);
         }
         Ok(())
     }
@@ -248,10 +268,12 @@ fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), ()> {
 
 /// `out = l⁻¹` for the lower-triangular `l` (non-zero diagonal), by columns: column `j` is the
 /// forward substitution of `e_j`, each step an axpy down a contiguous column of `l`.
-fn lower_inverse(l: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+/// (`reciprocal`: a buffer for the diagonal's reciprocals.)
+fn lower_inverse(l: &DMatrix<f64>, out: &mut DMatrix<f64>, reciprocal: &mut Vec<f64>) {
     let n = l.nrows();
     let l = l.as_slice();
-    let reciprocal: Vec<f64> = (0..n).map(|k| 1.0 / l[k * n + k]).collect();
+    reciprocal.clear();
+    reciprocal.extend((0..n).map(|k| 1.0 / l[k * n + k]));
     let o = out.as_mut_slice();
     o.fill(0.0);
     for j in 0..n {

@@ -19,7 +19,8 @@
 //! in which the constraints that are active (within [`TrajectoryOptions::active_slack`] of
 //! their bound, or past it) are held by a stiff penalty
 //! ([`TrajectoryOptions::active_penalty`]), solved and taken twice, linearised afresh
-//! ([`TrajectoryOptions::banded_steps`]); then one sweep over the frames solves each
+//! ([`TrajectoryOptions::banded_steps`]; the second left out after a short first,
+//! [`TrajectoryOptions::step_tolerance`]); then one sweep over the frames solves each
 //! frame's subproblem exactly, its neighbours held, every constraint a hard row of the frame's
 //! QP ([`crate::ik::Solver::trajectory_step`]). The sweep makes the result feasible and finds the
 //! constraints the next iteration holds; the banded step moves the whole window, which a
@@ -72,6 +73,10 @@ pub struct TrajectoryOptions {
     /// far (a waist or hip yaw 0.3–0.45 rad in a step, a planted sole's points 5–12 mm out of
     /// their grip on the SOMA walk onto the T1), and the sweep pulls a frame back only so far.
     pub banded_steps: usize,
+    /// An iteration's next banded step is left out when the one before moved no coordinate
+    /// of the window further than this (rad, m): from so short a step the linearisation
+    /// has little to correct. (0: every step taken.)
+    pub step_tolerance: f64,
     /// Window length (s).
     pub window_s: f64,
     /// Frames at the end of a window solved again by the next window (s).
@@ -110,6 +115,7 @@ impl Default for TrajectoryOptions {
             joint_cutoff_hz: 8.0,
             iterations: 2,
             banded_steps: 2,
+            step_tolerance: 0.02,
             window_s: 8.0,
             overlap_s: 1.0,
             max_step: 0.5,
@@ -318,7 +324,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let mut diagnostics = Vec::new();
         for _ in 0..self.options.iterations {
             for _ in 0..self.options.banded_steps {
-                self.banded_step(frames, first, &mut seq)?;
+                if self.banded_step(frames, first, &mut seq)? <= self.options.step_tolerance {
+                    break;
+                }
             }
             diagnostics = self.sweep(frames, first, &mut seq)?;
         }
@@ -361,17 +369,18 @@ impl<'s, 'm> Trajectory<'s, 'm> {
     }
 
     /// One Gauss–Newton step of the whole window: the banded system assembled at the current
-    /// trajectory, solved, and taken.
+    /// trajectory, solved, and taken. Returns how far it moved the coordinate it moved most.
     fn banded_step(
         &mut self,
         frames: &dyn Frames,
         first: usize,
         seq: &mut Sequence<'_>,
-    ) -> Result<(), Error> {
+    ) -> Result<f64, Error> {
         let model = self.solver.robot();
         let (nq, nv) = (model.nq, model.nv);
         let n = seq.qpos.len() / nq;
-        self.banded.clear();
+        // (frame_terms writes each frame's diagonal block and right-hand side whole.)
+        self.banded.clear_couplings();
         self.before_for = None;
         self.fixed_states(seq);
         for k in 0..n {
@@ -412,7 +421,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                 }
             }
         }
-        Ok(())
+        Ok(largest.min(self.options.max_step))
     }
 
     /// Frame `k`'s grips ([`crate::constraints::Grip`]) in the window's model, the solver
@@ -433,7 +442,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let model = self.solver.robot();
         let nv = model.nv;
         if self.before_for != Some(k) {
-            model.kinematics(before, &mut self.before);
+            // (Bodies and dof frames alone: the grip reads no geom.)
+            model.body_kinematics(before, &mut self.before);
         }
         let data = self.solver.data();
         let half = slip * self.dt;
@@ -563,15 +573,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         }
         // Rows at or past their bound are held: a·δ = max(b, 0) (a point on the floor stays
         // there, one below it comes up to it).
-        let rows: Vec<(Vec<f64>, f64)> = self
-            .solver
-            .constraint_rows()
-            .into_iter()
-            .filter(|(_, b)| *b > -slack)
-            .map(|(a, b)| (a.to_vec(), b.max(0.0)))
-            .collect();
-        for (a, b) in rows {
-            self.banded.add_penalty(k, &a, None, b, rho);
+        for (a, b) in self.solver.constraint_rows().into_iter().filter(|(_, b)| *b > -slack) {
+            self.banded.add_penalty(k, a, None, b.max(0.0), rho);
         }
         // Joints at a range end stay there.
         for joint in &model.joints {

@@ -38,7 +38,8 @@ pub(crate) fn body_poses(motion: &RobotMotion, model: &mjcf::Model) -> BodyPoses
     let mut pos = Vec::with_capacity(frames * bodies);
     let mut quat = Vec::with_capacity(frames * bodies);
     for t in 0..frames {
-        model.kinematics(motion.frame(t), &mut data);
+        // (The bodies' poses alone: no geom is read.)
+        model.body_kinematics(motion.frame(t), &mut data);
         pos.extend_from_slice(data.xpos.get(1..).unwrap_or_default());
         quat.extend_from_slice(data.xquat.get(1..).unwrap_or_default());
     }
