@@ -16,6 +16,21 @@ pub(crate) use nnls::{nnls, Column};
 /// Standard gravity (m/s²).
 pub const GRAVITY: f64 = 9.81;
 
+/// The half step `h` (frames) of accelerations averaged over `span` seconds at `fps`:
+/// `max(1, round(fps · span / 4))`. The dynamics check reads the centre of mass's
+/// acceleration over the `4h + 1` frames around a frame and counts the contacts of the
+/// `2h + 1` middle ones ([`crate::report::DynamicsCheckOptions::span`]); the solve's
+/// dynamics term counts the same contacts ([`crate::DynamicsOptions::span`]).
+#[must_use]
+pub fn half_step(fps: f64, span: f64) -> usize {
+    let h = (fps * span / 4.0).round();
+    if h.is_finite() && h >= 1.0 {
+        h as usize
+    } else {
+        1
+    }
+}
+
 /// A body with mass: its pose index (MuJoCo body − 1) and inertial.
 #[derive(Debug, Clone)]
 pub(crate) struct MassBody {

@@ -39,17 +39,7 @@ pub struct DynamicsCheckOptions {
     pub span: f64,
 }
 
-/// The half step `h` (frames) of the averaged accelerations at `fps` over `span` seconds
-/// ([`DynamicsCheckOptions::span`]): `max(1, round(fps · span / 4))`.
-#[must_use]
-pub fn half_step(fps: f64, span: f64) -> usize {
-    let h = (fps * span / 4.0).round();
-    if h.is_finite() && h >= 1.0 {
-        h as usize
-    } else {
-        1
-    }
-}
+pub use crate::centroidal::half_step;
 
 impl Default for DynamicsCheckOptions {
     fn default() -> Self {

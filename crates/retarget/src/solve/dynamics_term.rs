@@ -5,10 +5,12 @@
 //! `b_t = (m (c̈_t + g ẑ), L̇_t)` about the centre of mass `c` (`L`: the centroidal angular
 //! momentum). Contacts supply `w = Σ_k f_k (d_k, (p_k − c) × d_k)` with `f_k ≥ 0` along the
 //! edges `d_k` of friction pyramids at the candidate contact points `p_k` within
-//! [`DynamicsOptions::contact_height`] of the floor (as the quality report's dynamics check
-//! counts them: [`crate::report`]). The residual `r_t = b_t − w*_t`, `w*_t` the best supply
+//! [`DynamicsOptions::contact_height`] of the floor in the frames within a fixed time of `t`
+//! ([`DynamicsOptions::span`]; as the quality report's dynamics check counts them:
+//! [`crate::report`]). The residual `r_t = b_t − w*_t`, `w*_t` the best supply
 //! (non-negative least squares), in units of `m g` (force) and `m g L` (torque, `L` the
-//! robot's COM height at `qpos0`), costs `½ W |r_t|²` ([`DynamicsOptions::weight`]). In flight
+//! robot's COM height at `qpos0`), costs `½ W (|r_t| − ε)²` where it is longer than `ε`
+//! ([`DynamicsOptions::weight`], [`DynamicsOptions::tolerance`]). In flight
 //! no point is near the floor and the whole needed wrench is residual: the centre of mass is
 //! pulled onto its ballistic arc; in support the residual is what lies outside the friction
 //! cones and the support polygon (a centre of pressure beyond the soles).
@@ -27,14 +29,15 @@
 use mjcf::{Data, Model};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
-use crate::centroidal::GRAVITY;
 use crate::centroidal::{bottom_points, cone_edges, lever, mass_bodies, nnls, Column, MassBody};
+use crate::centroidal::{half_step, GRAVITY};
 
 /// Tunables of the dynamics term.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct DynamicsOptions {
-    /// Weight `W` of `½ |r|²` per frame (`r` in m·g and m·g·L); 0 turns the term off.
+    /// Weight `W` of `½ (|r| − ε)²` per frame (`r` in m·g and m·g·L); 0 turns the term off.
+    /// Default 2000 (decision 021).
     pub weight: f64,
     /// Candidate points within this of the floor (m) are contacts.
     pub contact_height: f64,
@@ -42,11 +45,28 @@ pub struct DynamicsOptions {
     pub friction: f64,
     /// Edges of each friction pyramid.
     pub cone_edges: usize,
+    /// Frame `t`'s supply counts the candidate points near the floor in the frames within
+    /// `h dt` of it, `h = max(1, round(span / (4 dt)))` (s), as the quality report's
+    /// dynamics check counts them ([`crate::report::DynamicsCheckOptions::span`]): the same
+    /// time at every frame rate. Default 1/6 s.
+    pub span: f64,
+    /// `ε`: a residual up to this length (m·g) costs nothing, a longer one `½ W (|r| − ε)²`.
+    /// Below it the residual says more of the contact model (a point 1 mm either side of
+    /// [`DynamicsOptions::contact_height`] supplies all or nothing) than of the motion.
+    /// Default 0.03 (the quality report's bar is 0.1).
+    pub tolerance: f64,
 }
 
 impl Default for DynamicsOptions {
     fn default() -> Self {
-        DynamicsOptions { weight: 300.0, contact_height: 0.01, friction: 0.8, cone_edges: 8 }
+        DynamicsOptions {
+            weight: 2000.0,
+            contact_height: 0.01,
+            friction: 0.8,
+            cone_edges: 8,
+            span: 1.0 / 6.0,
+            tolerance: 0.03,
+        }
     }
 }
 
@@ -163,9 +183,11 @@ impl Centroidal {
     }
 
     /// The supplies of the residual frames `1 ..= len − 2` of `states` (none at the ends: no
-    /// acceleration there), from the states as they are.
+    /// acceleration there), from the states as they are: the contacts of the frames within
+    /// [`DynamicsOptions::span`]'s half step of each.
     pub(crate) fn supplies(&self, states: &[FrameState], dt: f64) -> Vec<Option<Supply>> {
         let len = states.len();
+        let h = half_step(1.0 / dt, self.options.span);
         let momentum: Vec<Option<Vector3<f64>>> = (0..len)
             .map(|j| {
                 (j >= 1 && j + 1 < len)
@@ -186,7 +208,9 @@ impl Centroidal {
                 let c = states[t].com;
                 let b = self.needed(states, t, dt, &torque);
                 cols.clear();
-                for p in states[t - 1..=t + 1].iter().flat_map(|s| &s.near) {
+                for p in
+                    states[t.saturating_sub(h)..=(t + h).min(len - 1)].iter().flat_map(|s| &s.near)
+                {
                     let arm = (p - c) / self.lever;
                     cols.extend(self.edges.iter().map(|d| {
                         let m = arm.cross(d);
@@ -196,7 +220,7 @@ impl Centroidal {
                 let r = if cols.is_empty() { b } else { nnls(&cols, &b, &mut x) };
                 let supplied: Column = std::array::from_fn(|i| b[i] - r[i]);
                 let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let normal = (norm > 1e-9).then(|| r.map(|v| v / norm));
+                let normal = (norm > self.options.tolerance.max(1e-9)).then(|| r.map(|v| v / norm));
                 Some(Supply {
                     normal,
                     torque,
@@ -251,7 +275,7 @@ impl Centroidal {
     ) -> Option<f64> {
         let n = supply.normal?;
         let r = self.residual(states, t, supply, dt);
-        let d = (0..6).map(|i| n[i] * r[i]).sum::<f64>().max(0.0);
+        let d = ((0..6).map(|i| n[i] * r[i]).sum::<f64>() - self.options.tolerance).max(0.0);
         let s = t.checked_add_signed(offset)?;
         self.block(&states[s], supply, offset, dt, block);
         let nv = states[s].jac.len() / 3;
