@@ -22,6 +22,7 @@
 
 pub mod amass;
 pub mod fbx_target;
+mod generate;
 pub mod guard;
 pub mod motions;
 mod mutate;

@@ -9,8 +9,8 @@ use std::path::Path;
 
 use arbitrary::{Arbitrary, Result, Unstructured};
 
+use crate::generate::{g1, num_value, Num};
 use crate::seeds::files;
-use crate::targets::{g1, num_value, Num};
 use crate::Target;
 
 fn report(motion: &retarget::RobotMotion) -> std::result::Result<(), String> {

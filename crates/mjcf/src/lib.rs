@@ -43,6 +43,7 @@ mod sample;
 mod source;
 mod syntax;
 mod urdf;
+mod urdf_options;
 
 use std::path::Path;
 
@@ -54,7 +55,7 @@ pub use error::{Error, Location};
 pub use kinematics::Data;
 pub use math::axis_angle;
 pub use model::{Body, FloatingBase, Geom, GeomType, Inertial, Joint, JointType, Model, Site};
-pub use urdf::{UrdfBase, UrdfOptions};
+pub use urdf_options::{UrdfBase, UrdfOptions};
 
 impl Model {
     /// Reads and compiles an MJCF file; `<include>` paths are relative to its directory.

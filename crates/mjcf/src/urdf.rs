@@ -71,26 +71,7 @@ use crate::math::{orientation_to_quat, z_to_quat};
 use crate::model::{Body, Geom, GeomType, Inertial, Joint, JointType, Model};
 use crate::source::{Pos, Sources};
 use crate::syntax::Orientation;
-
-/// What becomes of the root link.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum UrdfBase {
-    /// The root link gets a free joint (`ROOT_free_joint`), unless the file has a `floating`
-    /// joint: what retargeting needs.
-    #[default]
-    Floating,
-    /// No joint is added: the robot is fixed to the world, exactly as MuJoCo compiles the file.
-    Fixed,
-}
-
-/// How a URDF becomes a [`Model`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct UrdfOptions {
-    pub base: UrdfBase,
-    /// Merge links without a joint into their parent body (MuJoCo's `fusestatic`). `None`:
-    /// as the file's `<mujoco><compiler fusestatic>` says, else MuJoCo's URDF default (merge).
-    pub fuse_static: Option<bool>,
-}
+use crate::urdf_options::{UrdfBase, UrdfOptions};
 
 // ------------------------------------------------------------------------------------------
 // Syntax: the typed tree of what the file says.

@@ -158,25 +158,33 @@
 use std::fmt;
 
 use nalgebra::Vector3;
-use serde::Serialize;
 
+mod checks;
 mod dynamics;
 mod foot_metrics;
+mod quality;
 mod rates;
+mod stats;
 mod text;
 mod verdict;
 
+pub use checks::{Caps, Check, GmrCaps, Verdict};
 pub use dynamics::{
     half_step, CentreOfPressure, Dynamics, DynamicsCheckOptions, Flight, FrameDynamics,
 };
+pub use quality::{
+    BodyTracking, Floating, FootReport, GroundPenetration, JointLimits, JointMotion,
+    JointSpeedReport, LimitViolation, QualityReport, Range, SelfCollision, Skating, Stance,
+};
 pub use rates::{AccelStats, AveragedAcceleration, Jitter, RootAcceleration, GRAVITY};
-pub use verdict::{Caps, Check, GmrCaps, Verdict};
+pub use stats::{percentile, Stats};
 
 use crate::constraints::support_offset;
 use crate::motion::RobotMotion;
 use crate::writers::{body_poses, check_motion, gradient_pair, gradient_rows, BodyPoses};
 use crate::Error;
 use foot_metrics::{floating, foot_heights, foot_report, skating, stance};
+use stats::{mean, ratio, scalar_joints, stats};
 
 /// Tunables of [`report`]; see the module documentation for the definitions.
 #[derive(Debug, Clone, PartialEq)]
@@ -251,222 +259,6 @@ impl Default for ReportOptions {
             caps: Caps::default(),
         }
     }
-}
-
-/// Mean, 95th percentile and maximum over frames.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Stats {
-    pub mean: f64,
-    pub p95: f64,
-    pub max: f64,
-}
-
-/// Tracking error of one target body.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct BodyTracking {
-    pub body: String,
-    /// Position error (m); `None` for a body whose position is not a target
-    /// ([`ReportOptions::position_targets`]).
-    pub pos_m: Option<Stats>,
-    /// Rotation error (rad).
-    pub rot_rad: Stats,
-}
-
-/// Joint-limit violations of one joint.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LimitViolation {
-    pub joint: String,
-    pub frames: usize,
-    /// Largest distance outside the range (rad or m).
-    pub max_excess: f64,
-}
-
-/// Joint-limit summary.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct JointLimits {
-    /// Frames × joints outside their range.
-    pub violations: usize,
-    pub max_excess: f64,
-    /// Only the joints that violate.
-    pub joints: Vec<LimitViolation>,
-}
-
-/// Speed and smoothness of one hinge or slide joint.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct JointMotion {
-    pub joint: String,
-    /// 99th percentile of `|q̇|`.
-    pub vel_p99: f64,
-    pub vel_max: f64,
-    /// Frames with `|q̇|` above [`ReportOptions::joint_velocity_limit`] (0 without a limit).
-    pub vel_over_limit: usize,
-    /// Mean `|q̈|` (rad/s² or m/s²).
-    pub jitter: f64,
-}
-
-/// Ground contact of one foot.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FootReport {
-    pub body: String,
-    /// `"geoms"` (lowest point of its collision geoms), `"inertia"` (of the equivalent box of
-    /// its mass and inertia, for a foot without geoms) or `"origin"` (body origin).
-    pub height_from: &'static str,
-    pub contact_frames: usize,
-    pub contact_phases: usize,
-    pub sliding_frames: usize,
-    /// Sliding frames / contact frames (0 without contact).
-    pub sliding_share: f64,
-    pub slide_per_phase_cm_mean: f64,
-    pub slide_per_phase_cm_max: f64,
-    /// Frames with the sole on the floor (lower than [`ReportOptions::floor_height`]), and
-    /// those of them in which its contact point moves faster than
-    /// [`ReportOptions::skate_speed`] (skating measured on the robot's own contacts, whatever
-    /// the source's), and their share.
-    pub floor_frames: usize,
-    pub floor_skating_frames: usize,
-    pub floor_skating_share: f64,
-    /// Frames with the foot below the ground.
-    pub penetration_frames: usize,
-    pub penetration_cm_max: f64,
-    /// Mean over the penetrating frames (0 without any).
-    pub penetration_cm_mean: f64,
-}
-
-/// Frames with neither foot near the ground.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Floating {
-    pub frames: usize,
-    pub share: f64,
-    /// Mean over all frames of `max(0, lowest foot height)` (cm).
-    pub cm_mean: f64,
-    pub cm_max: f64,
-}
-
-/// Min, mean and max.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Range {
-    pub min: f64,
-    pub mean: f64,
-    pub max: f64,
-}
-
-/// Ground penetration of every collision geom (see the module documentation).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct GroundPenetration {
-    /// Collision geoms considered.
-    pub geoms: usize,
-    /// [`ReportOptions::penetration_tolerance`] (cm).
-    pub tolerance_cm: f64,
-    /// Frames deeper than the tolerance.
-    pub frames: usize,
-    /// `frames` / all frames (holosoma's `penetration_duration`).
-    pub duration: f64,
-    /// Deepest penetration over all frames (cm), 0 without any.
-    pub max_depth_cm: f64,
-    /// The geom of the deepest penetration (its name, or `geom N` when it has none).
-    pub worst_geom: Option<String>,
-}
-
-/// Robot self-collision (see the module documentation).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SelfCollision {
-    /// Geom pairs checked.
-    pub pairs: usize,
-    /// Pairs left out because they touch or overlap at `qpos0`.
-    pub ignored_pairs: usize,
-    /// Pairs left out because their bodies are adjacent in effect (joined through bodies
-    /// without collision geoms; see [`mjcf::Model::self_collision_pairs`]).
-    pub adjacent_pairs: usize,
-    /// [`ReportOptions::self_collision_depth`] (cm).
-    pub deep_cm: f64,
-    /// Frames with a pair deeper than `deep_cm`.
-    pub frames_deep: usize,
-    /// Frames with any penetrating pair.
-    pub frames_penetrating: usize,
-    /// Deepest penetration (cm), 0 without any.
-    pub max_depth_cm: f64,
-    /// The two geoms of the deepest penetration.
-    pub worst_pair: Option<[String; 2]>,
-}
-
-/// Foot skating against the source's contacts (holosoma's `foot_skating_metrics`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Skating {
-    /// [`ReportOptions::skate_speed`] (m/s).
-    pub threshold_mps: f64,
-    /// Frames with a foot in source contact.
-    pub stance_frames: usize,
-    /// Frames with a skating foot.
-    pub skating_frames: usize,
-    /// `skating_frames / stance_frames` (0 without stance).
-    pub duration: f64,
-    /// Fastest skating foot (m/s), 0 without any.
-    pub max_speed: f64,
-}
-
-/// Foot height while the source foot is in contact.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Stance {
-    /// Foot × frame samples in source contact.
-    pub samples: usize,
-    /// [`ReportOptions::stance_float_height`] and [`ReportOptions::sole_band`] (cm).
-    pub float_cm: f64,
-    pub band_cm: [f64; 2],
-    /// Of those, samples with the foot above the floating height.
-    pub floating: usize,
-    pub floating_share: f64,
-    /// Share of samples with the foot height within the sole band.
-    pub sole_in_band_share: f64,
-}
-
-/// Joint speeds against the joints' published limits.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct JointSpeedReport {
-    /// Joints with a limit.
-    pub joints: usize,
-    /// Frames × joints over their limit.
-    pub violations: usize,
-    /// Largest `|q̇| / limit`.
-    pub worst_ratio: f64,
-    pub worst_joint: String,
-}
-
-/// The quality report of one motion (serialises to JSON; `Display` prints a table).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct QualityReport {
-    /// Every measure against its cap; printed first.
-    pub verdict: Verdict,
-    pub robot: String,
-    pub frames: usize,
-    pub fps: f64,
-    /// Per target body, when the motion has targets.
-    pub tracking: Option<Vec<BodyTracking>>,
-    pub joint_limits: JointLimits,
-    pub joints: Vec<JointMotion>,
-    pub feet: Vec<FootReport>,
-    pub floating: Floating,
-    /// Root height (m).
-    pub root_height: Range,
-    pub ground_penetration: GroundPenetration,
-    pub self_collision: SelfCollision,
-    /// `None` without the source's foot contacts.
-    pub skating: Option<Skating>,
-    /// `None` without the source's foot contacts.
-    pub stance: Option<Stance>,
-    /// `None` when no joint has a published speed limit.
-    pub joint_speed: Option<JointSpeedReport>,
-    /// The root's acceleration, and its target's.
-    pub root_acceleration: RootAcceleration,
-    /// Mean `|q̈|` over every velocity coordinate, the root's included.
-    pub jitter: Jitter,
-    /// The dynamics check, accelerations averaged over [`DynamicsCheckOptions::span`]; `None`
-    /// when the model's masses are not known or the clip is shorter than the span
-    /// ([`QualityReport::dynamics_unavailable`] says why).
-    pub dynamics: Option<Dynamics>,
-    pub dynamics_unavailable: Option<String>,
-    /// The same check on the 5 frames around each frame whatever the rate (the figure of
-    /// earlier reports, kept beside for continuity; equal to `dynamics` at 24–35 fps).
-    pub dynamics_5_frame: Option<Dynamics>,
 }
 
 /// Computes the [`QualityReport`] of `motion` on `model` (the robot it was solved for).
@@ -699,14 +491,6 @@ fn tracking(
     Ok(Some(out))
 }
 
-/// Limited hinge and slide joints: `(joint index, qpos address)`.
-fn scalar_joints(model: &mjcf::Model) -> impl Iterator<Item = (usize, usize)> + '_ {
-    model.joints.iter().enumerate().filter_map(|(j, joint)| {
-        matches!(joint.kind, mjcf::JointType::Hinge | mjcf::JointType::Slide)
-            .then_some((j, joint.qpos_adr))
-    })
-}
-
 fn joint_limits(motion: &RobotMotion, model: &mjcf::Model, tol: f64) -> JointLimits {
     let mut joints = Vec::new();
     for (j, a) in scalar_joints(model) {
@@ -755,58 +539,10 @@ fn joint_motion(motion: &RobotMotion, model: &mjcf::Model, limit: Option<f64>) -
         .collect()
 }
 
-fn ratio(a: usize, b: usize) -> f64 {
-    if b == 0 {
-        0.0
-    } else {
-        a as f64 / b as f64
-    }
-}
-
-fn mean(x: &[f64]) -> f64 {
-    if x.is_empty() {
-        0.0
-    } else {
-        x.iter().sum::<f64>() / x.len() as f64
-    }
-}
-
-/// numpy's `percentile(x, 100 p)` with linear interpolation; 0 for no data. The one rule of
-/// every percentile we print (the report, the main command's summary, batch summaries).
-#[must_use]
-pub fn percentile(x: &[f64], p: f64) -> f64 {
-    if x.is_empty() {
-        return 0.0;
-    }
-    let mut s = x.to_vec();
-    s.sort_by(f64::total_cmp);
-    let pos = p * (s.len() - 1) as f64;
-    let (i, frac) = (pos.floor() as usize, pos - pos.floor());
-    let next = s[(i + 1).min(s.len() - 1)];
-    s[i] + (next - s[i]) * frac
-}
-
-fn stats(x: &[f64]) -> Stats {
-    Stats { mean: mean(x), p95: percentile(x, 0.95), max: x.iter().copied().fold(0.0, f64::max) }
-}
-
 fn range(x: &[f64]) -> Range {
     Range {
         min: x.iter().copied().fold(f64::INFINITY, f64::min),
         mean: mean(x),
         max: x.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn percentile_is_numpys_linear() {
-        // numpy.percentile([1, 2, 3, 4], 95) = 3.85
-        assert!((percentile(&[4.0, 1.0, 3.0, 2.0], 0.95) - 3.85).abs() < 1e-12);
-        assert_eq!(percentile(&[7.0], 0.99), 7.0);
-        assert_eq!(percentile(&[], 0.5), 0.0);
     }
 }

@@ -236,13 +236,8 @@ pub(super) fn separate(
 
 #[cfg(test)]
 mod tests {
-    use mjcf::GeomType;
-    use nalgebra::Isometry3;
-
     use super::*;
     use crate::feet::soles::fixtures::box_foot;
-    use crate::feet::{plan, FootPlanOptions};
-    use crate::motion::FootContacts;
 
     #[test]
     fn planted_soles_are_kept_apart() {
@@ -266,85 +261,6 @@ mod tests {
         let before = anchors.clone();
         separate(&foot, &foot, &mut anchors, 0.02);
         assert_eq!(anchors, before);
-    }
-
-    /// One stance phase of 30 frames whose source foot turns through `turn` (rad) about its
-    /// toe, standing flat: the planned foot targets and the foot.
-    fn turning_stance(turn: f64) -> (Vec<Pose>, RobotFoot) {
-        let mut foot = box_foot();
-        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
-        let frames = 30;
-        let toe = foot.toe_point();
-        let mut targets: Vec<Pose> = (0..frames)
-            .map(|t| {
-                let yaw = turn * t as f64 / (frames - 1) as f64;
-                let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
-                // The toe stays at (0.1, 0, ·): the origin turns about it.
-                let pos = Vector3::new(toe.x, toe.y, 0.02) - q * Vector3::new(toe.x, toe.y, 0.0);
-                Pose { quat: [q.w, q.i, q.j, q.k], pos }
-            })
-            .collect();
-        let contacts =
-            FootContacts { left: vec![true; frames], right: vec![false; frames], on_toes: None };
-        let options = FootPlanOptions::default();
-        plan(&[Some(foot.clone()), None], &contacts, &mut targets, 1, 30.0, &options);
-        (targets, foot)
-    }
-
-    #[test]
-    fn a_foot_that_turns_far_in_stance_pivots_about_its_ball() {
-        let yaw = |p: &Pose| quat(p).euler_angles().2;
-        // 90°: the planted (left) foot turns with the source's about the ball of its foot,
-        // the inner toe corner, which stays still.
-        let (targets, foot) = turning_stance(std::f64::consts::FRAC_PI_2);
-        assert_eq!(foot.ball_point(0), Vector3::new(0.1, -0.05, -0.02));
-        let ball = |p: &Pose| p.pos + quat(p) * foot.ball_point(0);
-        let first = ball(&targets[0]);
-        for (t, p) in targets.iter().enumerate() {
-            let expected = std::f64::consts::FRAC_PI_2 * t as f64 / 29.0;
-            assert!((yaw(p) - expected).abs() < 1e-9, "frame {t}: yaw {}", yaw(p));
-            let moved = (ball(p) - first).xy().norm();
-            assert!(moved < 1e-9, "frame {t}: the ball moved {moved} m");
-        }
-        // 20°, under `pivot_turn`: one yaw for the whole phase (the mean), the foot still.
-        let (targets, _) = turning_stance(20f64.to_radians());
-        for p in &targets {
-            assert!((yaw(p) - 10f64.to_radians()).abs() < 1e-6, "yaw {}", yaw(p));
-            assert!((p.pos - targets[0].pos).norm() < 1e-9);
-        }
-    }
-
-    #[test]
-    fn a_fast_pivot_turns_on_the_ball_of_the_foot_with_its_heel_up() {
-        let lift = FootPlanOptions::default().pivot_heel_lift;
-        let heel_over_toe = |p: &Pose, foot: &RobotFoot| {
-            let z: Vec<f64> = foot.corners.iter().map(|c| (p.pos + quat(p) * c).z).collect();
-            (z[0] + z[1]) / 2.0 - (z[2] + z[3]) / 2.0
-        };
-        // 90° in 1 s: flat, the 20 cm sole's heel would sweep the floor at 0.3 m/s.
-        let (targets, foot) = turning_stance(std::f64::consts::FRAC_PI_2);
-        for (t, p) in targets.iter().enumerate() {
-            let up = heel_over_toe(p, &foot);
-            assert!((up - lift).abs() < 1e-9, "frame {t}: heel {up} m above the toe");
-            // It stands on the ball alone (the inner toe corner), its outer toe corner up.
-            let low = targets[t].pos.z + (quat(p) * foot.corners[2]).z;
-            assert!(
-                (low - FootPlanOptions::default().clearance).abs() < 1e-9,
-                "frame {t}: ball at {low}"
-            );
-            // (CONTACT_PATCH across the sole, pitched heel up: cos 5.7° of it.)
-            let outer = targets[t].pos.z + (quat(p) * foot.corners[3]).z;
-            assert!(
-                (outer - low - crate::feet::soles::CONTACT_PATCH).abs() < 1e-4,
-                "frame {t}: outer toe {} m above the ball",
-                outer - low
-            );
-        }
-        // A slow pivot, 46° in 1 s (0.16 m/s, under `pivot_heel_speed`), lifts it part of the
-        // way.
-        let (slow, foot) = turning_stance(46f64.to_radians());
-        let up = heel_over_toe(&slow[15], &foot);
-        assert!(up > 0.0 && up < lift, "slow pivot: heel {up} m up");
     }
 
     #[test]

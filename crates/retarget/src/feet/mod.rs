@@ -72,6 +72,8 @@ mod plan_options;
 mod soles;
 mod stance;
 mod swing;
+#[cfg(test)]
+mod tests;
 
 use crate::lie::Pose;
 use crate::motion::FootContacts;

@@ -342,7 +342,7 @@ pub(super) mod fixtures {
     use super::*;
 
     /// A flat foot with a 20 × 10 cm box sole, its origin at the sole's centre, facing +x.
-    pub(in crate::feet) fn box_foot() -> RobotFoot {
+    pub(crate) fn box_foot() -> RobotFoot {
         let corners = [(-0.1, -0.05), (-0.1, 0.05), (0.1, -0.05), (0.1, 0.05)]
             .map(|(x, y)| Vector3::new(x, y, -0.02))
             .to_vec();
@@ -410,5 +410,43 @@ mod tests {
             .map(|(x, y)| Vector3::new(x, y, -0.05))
             .to_vec();
         assert_eq!(sorted(foot.corners.clone()), sorted(rim));
+    }
+
+    #[test]
+    fn a_foot_without_geoms_stands_on_its_inertia_box() {
+        // The N1 motion-capture model's foot: no geoms, 0.528 kg, centre of mass 3.1 cm ahead
+        // of and 3.2 cm below the ankle, principal moments giving a 19.2 × 6.8 × 3.4 cm box
+        // (long axis along the principal z, turned onto the body's x).
+        let xml = r#"<mujoco><worldbody><body name="foot" pos="0 0 0.05"><freejoint/>
+            <body name="toe"/></body></worldbody></mujoco>"#;
+        let mut model = Model::from_xml_str(xml, None).unwrap();
+        let inertial = mjcf::Inertial {
+            mass: 0.528,
+            pos: Vector3::new(0.031, 0.0, -0.032),
+            quat: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2),
+            diag: Vector3::new(0.00183246, 0.00168042, 0.000253637),
+        };
+        model.bodies[1].inertial = Some(inertial);
+        let foot = RobotFoot::new(&model, 1, 1, 0, None).unwrap();
+        let half = inertial.equivalent_box().unwrap();
+        assert!((half.z - 0.096).abs() < 1e-3 && (half.x - 0.017).abs() < 1e-3, "{half:?}");
+        // Four bottom corners, 1.7 cm under the centre of mass, 9.6 cm ahead and behind it.
+        assert_eq!(foot.corners.len(), 4);
+        for c in &foot.corners {
+            assert!((c.z - (-0.032 - half.x)).abs() < 1e-9, "{c:?}");
+            assert!(((c.x - 0.031).abs() - half.z).abs() < 1e-9, "{c:?}");
+        }
+        assert!((foot.sole_offset(&UnitQuaternion::identity()) + 0.032 + half.x).abs() < 1e-9);
+        // A body with no mass, or a box no foot is (a point mass, a 1 m beam), is no sole.
+        model.bodies[1].inertial = Some(mjcf::Inertial { mass: 0.0, ..inertial });
+        assert!(RobotFoot::new(&model, 1, 1, 0, None).is_none());
+        model.bodies[1].inertial =
+            Some(mjcf::Inertial { diag: Vector3::new(0.0440, 0.0440, 1e-5), ..inertial });
+        assert!(RobotFoot::new(&model, 1, 1, 0, None).is_none());
+        // The heaviest plausible body below the foot is taken.
+        model.bodies[1].inertial = None;
+        model.bodies[2].inertial = Some(inertial);
+        let toe = RobotFoot::new(&model, 1, 1, 0, None).unwrap();
+        assert_eq!(toe.corners.len(), 4);
     }
 }

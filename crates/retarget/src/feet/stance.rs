@@ -50,7 +50,7 @@ impl RobotFoot {
 
     /// How far (m) the sole's highest bottom point stands above its lowest at orientation
     /// `rot`.
-    fn height_spread(&self, rot: &UnitQuaternion<f64>) -> f64 {
+    pub(super) fn height_spread(&self, rot: &UnitQuaternion<f64>) -> f64 {
         let z = self.corners.iter().map(|c| (rot * c).z);
         let (lo, hi) = z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
         hi - lo
@@ -229,86 +229,4 @@ pub(super) fn planted_pose(
     let rolled = q * low;
     let pos = Vector3::new(contact.x - rolled.x, contact.y - rolled.y, clearance - rolled.z);
     Pose { quat: [q.w, q.i, q.j, q.k], pos }
-}
-
-#[cfg(test)]
-mod tests {
-    use mjcf::GeomType;
-    use nalgebra::Isometry3;
-
-    use super::*;
-    use crate::feet::plan;
-    use crate::feet::soles::fixtures::box_foot;
-    use crate::motion::FootContacts;
-
-    /// A planted foot whose human foot stands 10° toes-down: alone on the floor it stands
-    /// on its whole sole (corners within the band); while the other foot stands too, it
-    /// rolls with the human's.
-    #[test]
-    fn a_foot_alone_on_the_floor_stands_on_its_whole_sole() {
-        let options = FootPlanOptions::default();
-        let mut foot = box_foot();
-        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
-        let fps = 30.0;
-        let frames = 60;
-        let toes_down = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 0.17);
-        let q = toes_down.quaternion();
-        let tilted = Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.0, 0.0, 0.05) };
-        let beside = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(0.0, 0.3, 0.02) };
-        let mut targets: Vec<Pose> = (0..frames).flat_map(|_| [tilted, beside]).collect();
-        // The right foot stands in the second half only.
-        let contacts = FootContacts {
-            left: vec![true; frames],
-            right: (0..frames).map(|t| t >= 30).collect(),
-            on_toes: None,
-        };
-        let feet = [Some(foot.clone()), Some(RobotFoot { slot: 1, ..foot.clone() })];
-        plan(&feet, &contacts, &mut targets, 2, fps, &options);
-        let spread = |p: &Pose| foot.height_spread(&quat(p));
-        assert!(spread(&targets[10 * 2]) <= options.sole_band + 1e-9, "{}", spread(&targets[20]));
-        // Deep in the double support: the human's 10°, its corners 3.5 cm apart in height.
-        assert!(spread(&targets[45 * 2]) > 0.03, "{}", spread(&targets[90]));
-    }
-
-    /// A foot alone on the floor whose human stands on its toes, 40° toe-down (kneeling,
-    /// tiptoe), in the second half: there the sole's heel stands as high above its toes as
-    /// the human's (sole length × sin 40°) and its front rests on the floor at the anchor;
-    /// in the first half it stands on its whole sole. Without the label, whole sole
-    /// throughout.
-    #[test]
-    fn a_foot_whose_human_stands_on_its_toes_stands_on_the_front_of_its_sole() {
-        let options = FootPlanOptions::default();
-        let mut foot = box_foot();
-        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
-        let frames = 60;
-        let toes_down = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), 40f64.to_radians());
-        let q = toes_down.quaternion();
-        let tilted = Pose { quat: [q.w, q.i, q.j, q.k], pos: Vector3::new(0.0, 0.0, 0.1) };
-        let beside = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(0.0, 0.3, 0.5) };
-        let feet = [Some(foot.clone()), None];
-        let planned = |on_toes: Option<[Vec<bool>; 2]>| {
-            let mut targets: Vec<Pose> = (0..frames).flat_map(|_| [tilted, beside]).collect();
-            let contacts =
-                FootContacts { left: vec![true; frames], right: vec![false; frames], on_toes };
-            plan(&feet, &contacts, &mut targets, 2, 30.0, &options);
-            targets
-        };
-        let heights = |p: &Pose| -> Vec<f64> {
-            foot.corners.iter().map(|c| (quat(p) * c + p.pos).z).collect()
-        };
-        let lift = |p: &Pose| foot.height_spread(&quat(p));
-        let toes: Vec<bool> = (0..frames).map(|t| t >= 30).collect();
-        let on_toes = planned(Some([toes, vec![false; frames]]));
-        let human = 0.2 * 40f64.to_radians().sin();
-        assert!(lift(&on_toes[10 * 2]) <= options.sole_band + 1e-9, "{}", lift(&on_toes[20]));
-        assert!(
-            (lift(&on_toes[50 * 2]) - human).abs() < 1e-6,
-            "{} vs {human}",
-            lift(&on_toes[100])
-        );
-        let lowest = heights(&on_toes[50 * 2]).into_iter().fold(f64::INFINITY, f64::min);
-        assert!((lowest - options.clearance).abs() < 1e-9, "{lowest}");
-        let flat = planned(None);
-        assert!(lift(&flat[50 * 2]) <= options.sole_band + 1e-9, "{}", lift(&flat[100]));
-    }
 }

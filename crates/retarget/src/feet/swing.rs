@@ -123,62 +123,6 @@ mod tests {
 
     use super::*;
     use crate::feet::soles::fixtures::box_foot;
-    use crate::feet::{plan, FootPlan};
-    use crate::motion::FootContacts;
-
-    /// One step of a flat box foot (sole 2 cm below its origin) at `fps`: planted for the
-    /// first and last third of a 1 s clip, in between it moves 0.5 m forward barely off the
-    /// floor (1 cm at most). Returns the planned foot targets and the contact labels.
-    fn low_step(fps: f64) -> (Vec<Pose>, Vec<bool>, FootPlan) {
-        low_step_with(fps, &FootPlanOptions::default())
-    }
-
-    fn low_step_with(fps: f64, options: &FootPlanOptions) -> (Vec<Pose>, Vec<bool>, FootPlan) {
-        let mut foot = box_foot();
-        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
-        let frames = fps as usize;
-        let (lift, touch) = (frames / 3, 2 * frames / 3);
-        let labels: Vec<bool> = (0..frames).map(|t| t < lift || t >= touch).collect();
-        let mut targets: Vec<Pose> = (0..frames)
-            .map(|t| {
-                let u = ((t as f64 - lift as f64) / (touch - lift) as f64).clamp(0.0, 1.0);
-                let pos =
-                    Vector3::new(0.5 * u, 0.0, 0.02 + 0.01 * (std::f64::consts::PI * u).sin());
-                Pose { quat: [1.0, 0.0, 0.0, 0.0], pos }
-            })
-            .collect();
-        let contacts =
-            FootContacts { left: labels.clone(), right: vec![false; frames], on_toes: None };
-        let plan = plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, options);
-        (targets, labels, plan)
-    }
-
-    /// A foot the source never stands on in the clip (a 24-frame run cycle's, its toe
-    /// brushing the floor at 4 m/s) swings from the clip's first frame to its last: it clears
-    /// the floor but in those two frames, where it may be landing or leaving.
-    #[test]
-    fn a_foot_never_planted_clears_the_floor_between_the_clip_ends() {
-        let options = FootPlanOptions::default();
-        let mut foot = box_foot();
-        foot.sole = vec![(GeomType::Box, [0.1, 0.05, 0.02], Isometry3::identity())];
-        let (fps, frames) = (30.0, 24);
-        let mut targets: Vec<Pose> = (0..frames)
-            .map(|t| Pose {
-                quat: [1.0, 0.0, 0.0, 0.0],
-                pos: Vector3::new(4.0 * t as f64 / fps, 0.0, 0.02),
-            })
-            .collect();
-        let contacts =
-            FootContacts { left: vec![false; frames], right: vec![false; frames], on_toes: None };
-        let plan = plan(&[Some(foot), None], &contacts, &mut targets, 1, fps, &options);
-        for (t, target) in targets.iter().enumerate().take(frames - 1).skip(1) {
-            assert_eq!(plan.swing_floor[t][0], Some(options.swing_clearance), "frame {t}");
-            assert!(target.pos.z - 0.02 >= options.swing_clearance - 1e-9, "frame {t}");
-            assert!(plan.contact[t][0].is_empty(), "nothing to hold: {t}");
-        }
-        assert!(plan.swing_floor[0][0].unwrap_or(0.0) < options.swing_clearance);
-        assert!(plan.swing_floor[frames - 1][0].unwrap_or(0.0) < options.swing_clearance);
-    }
 
     #[test]
     fn a_foot_rising_from_its_toes_holds_them_as_firmly_as_a_planted_sole() {
@@ -193,48 +137,6 @@ mod tests {
             assert!(p.point.x > 0.0, "a toe point: {p:?}");
             assert!((p.horizontal - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12, "{p:?}");
             assert_eq!(p.vertical, 0.0);
-        }
-    }
-
-    #[test]
-    fn swing_feet_clear_the_floor_and_lift_before_they_move() {
-        let options = FootPlanOptions::default();
-        for fps in [30.0, 120.0] {
-            let (targets, labels, plan) = low_step(fps);
-            let sole = |p: &Pose| p.pos.z - 0.02;
-            let lift = labels.iter().position(|c| !c).unwrap_or(0);
-            let touch = lift + labels[lift..].iter().position(|c| *c).unwrap_or(0);
-            let lead = (options.lead_s * fps).round() as usize;
-            let rise = (options.lift_s * fps).round() as usize;
-            // Planted frames rest on the floor.
-            assert!((sole(&targets[lift - 1]) - options.clearance).abs() < 1e-9, "fps {fps}");
-            for t in lift..touch - lead {
-                let off = (t + 1 - lift).min(touch - lead - t);
-                let floor = plan.swing_floor[t][0].unwrap_or(0.0);
-                assert!(sole(&targets[t]) >= floor - 1e-9, "fps {fps} frame {t}");
-                if off >= rise {
-                    // Clear of the floor (the free target is 1 cm up at most).
-                    assert!((floor - options.swing_clearance).abs() < 1e-9, "fps {fps} {t}");
-                }
-                if off > rise {
-                    assert!(plan.contact[t][0].is_empty(), "fps {fps} frame {t}");
-                } else {
-                    // Rising or coming down: the sole points on the floor at the edge are
-                    // held where they stand, horizontally only.
-                    let anchor = if t - lift < touch - lead - t { lift - 1 } else { touch - lead };
-                    let held = &plan.contact[t][0];
-                    assert!(!held.is_empty(), "fps {fps} frame {t}");
-                    // As firmly in all as a planted sole's points.
-                    let rss = held.iter().map(|p| p.horizontal * p.horizontal).sum::<f64>();
-                    assert!((rss - 1.0).abs() < 1e-9, "fps {fps} frame {t}: {rss}");
-                    for p in held {
-                        let at_edge = targets[anchor].pos + quat(&targets[anchor]) * p.point;
-                        assert!(p.vertical == 0.0 && p.horizontal > 0.0);
-                        assert!((p.at - at_edge).xy().norm() < 1e-9, "fps {fps} frame {t}");
-                    }
-                }
-            }
-            assert_eq!(plan.weight.len(), labels.len());
         }
     }
 }

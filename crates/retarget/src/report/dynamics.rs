@@ -11,7 +11,7 @@ use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use serde::Serialize;
 
 use super::rates::GRAVITY;
-use super::{ratio, stats, Stats};
+use super::stats::{ratio, stats, Stats};
 use crate::centroidal::{bottom_points, cone_edges, lever, mass_bodies, nnls, Column, MassBody};
 use crate::motion::RobotMotion;
 use crate::writers::BodyPoses;

@@ -8,7 +8,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Serialize;
 
-use super::mean;
+use super::stats::{mean, ratio};
 use crate::motion::RobotMotion;
 use crate::writers::BodyPoses;
 
@@ -139,7 +139,7 @@ pub(super) fn accel_stats(p: &[Vector3<f64>], fps: f64, s: usize) -> AccelStats 
         mean_mps2: mean(&a),
         max_mps2: a.iter().copied().fold(0.0, f64::max),
         frames_over,
-        share_over: super::ratio(frames_over, a.len()),
+        share_over: ratio(frames_over, a.len()),
     }
 }
 
