@@ -591,20 +591,3 @@ fn a_planted_foot_holds_through_the_window_step() {
     let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
-
-/// Issue 40 (decision 021): a still subject stands over its feet. The Blender barbarian's
-/// idle (a stylised rig) onto the G1: with the dynamics term at `W = 300` its centre of
-/// pressure stayed 11 cm outside the soles and 64 % of its frames needed more than 0.1 m·g
-/// of extra wrench (the corpus gate's cap is 40 %).
-#[test]
-fn a_still_subject_stands_over_its_feet() {
-    let Some(path) = shared::shared_file("data/fbx/ufbx_barbarian_idle_blender293.fbx") else {
-        return;
-    };
-    let r = retarget::Retargeter::new("unitree_g1").unwrap();
-    let (motion, _) = r.retarget_fbx_file(&path, None).unwrap();
-    let rep = report(&motion, r.model(), &ReportOptions::default()).unwrap();
-    let share = rep.dynamics.as_ref().unwrap().share_over;
-    eprintln!("barbarian idle onto the G1: {:.1} % of frames over 0.1 m·g", 100.0 * share);
-    assert!(share < 0.4, "{share}");
-}

@@ -9,8 +9,7 @@
 //! ([`DynamicsOptions::span`]; as the quality report's dynamics check counts them:
 //! [`crate::report`]). The residual `r_t = b_t − w*_t`, `w*_t` the best supply
 //! (non-negative least squares), in units of `m g` (force) and `m g L` (torque, `L` the
-//! robot's COM height at `qpos0`), costs `½ W (|r_t| − ε)²` where it is longer than `ε`
-//! ([`DynamicsOptions::weight`], [`DynamicsOptions::tolerance`]). In flight
+//! robot's COM height at `qpos0`), costs `½ W |r_t|²` ([`DynamicsOptions::weight`]). In flight
 //! no point is near the floor and the whole needed wrench is residual: the centre of mass is
 //! pulled onto its ballistic arc; in support the residual is what lies outside the friction
 //! cones and the support polygon (a centre of pressure beyond the soles).
@@ -36,8 +35,8 @@ use crate::centroidal::{half_step, GRAVITY};
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct DynamicsOptions {
-    /// Weight `W` of `½ (|r| − ε)²` per frame (`r` in m·g and m·g·L); 0 turns the term off.
-    /// Default 2000 (decision 021).
+    /// Weight `W` of `½ |r|²` per frame (`r` in m·g and m·g·L); 0 turns the term off.
+    /// Default 300 (decision 021).
     pub weight: f64,
     /// Candidate points within this of the floor (m) are contacts.
     pub contact_height: f64,
@@ -50,22 +49,16 @@ pub struct DynamicsOptions {
     /// dynamics check counts them ([`crate::report::DynamicsCheckOptions::span`]): the same
     /// time at every frame rate. Default 1/6 s.
     pub span: f64,
-    /// `ε`: a residual up to this length (m·g) costs nothing, a longer one `½ W (|r| − ε)²`.
-    /// Below it the residual says more of the contact model (a point 1 mm either side of
-    /// [`DynamicsOptions::contact_height`] supplies all or nothing) than of the motion.
-    /// Default 0.03 (the quality report's bar is 0.1).
-    pub tolerance: f64,
 }
 
 impl Default for DynamicsOptions {
     fn default() -> Self {
         DynamicsOptions {
-            weight: 2000.0,
+            weight: 300.0,
             contact_height: 0.01,
             friction: 0.8,
             cone_edges: 8,
             span: 1.0 / 6.0,
-            tolerance: 0.03,
         }
     }
 }
@@ -220,7 +213,7 @@ impl Centroidal {
                 let r = if cols.is_empty() { b } else { nnls(&cols, &b, &mut x) };
                 let supplied: Column = std::array::from_fn(|i| b[i] - r[i]);
                 let norm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                let normal = (norm > self.options.tolerance.max(1e-9)).then(|| r.map(|v| v / norm));
+                let normal = (norm > 1e-9).then(|| r.map(|v| v / norm));
                 Some(Supply {
                     normal,
                     torque,
@@ -275,7 +268,7 @@ impl Centroidal {
     ) -> Option<f64> {
         let n = supply.normal?;
         let r = self.residual(states, t, supply, dt);
-        let d = ((0..6).map(|i| n[i] * r[i]).sum::<f64>() - self.options.tolerance).max(0.0);
+        let d = (0..6).map(|i| n[i] * r[i]).sum::<f64>().max(0.0);
         let s = t.checked_add_signed(offset)?;
         self.block(&states[s], supply, offset, dt, block);
         let nv = states[s].jac.len() / 3;
