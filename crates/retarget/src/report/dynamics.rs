@@ -12,6 +12,7 @@ use serde::Serialize;
 
 use super::rates::GRAVITY;
 use super::stats::{ratio, stats, Stats};
+pub use crate::centroidal::half_step;
 use crate::centroidal::{bottom_points, cone_edges, lever, mass_bodies, nnls, Column, MassBody};
 use crate::motion::RobotMotion;
 use crate::writers::BodyPoses;
@@ -38,8 +39,6 @@ pub struct DynamicsCheckOptions {
     /// frame whatever the clip's rate (5 frames at 30 fps, 21 at 120). Default 1/6 s.
     pub span: f64,
 }
-
-pub use crate::centroidal::half_step;
 
 impl Default for DynamicsCheckOptions {
     fn default() -> Self {

@@ -76,19 +76,11 @@ impl Banded {
         self.frames
     }
 
-    /// Sets every block and the right-hand side to zero (the next system of the same size).
-    pub fn clear(&mut self) {
-        // (Through the slices: nalgebra's `fill` walks a generic strided iterator.)
-        for m in self.diag.iter_mut().chain(&mut self.sub1).chain(&mut self.sub2) {
-            m.as_mut_slice().fill(0.0);
-        }
-        self.rhs.as_mut_slice().fill(0.0);
-    }
-
-    /// [`Banded::clear`] but for the diagonal blocks and the right-hand side, for a caller
-    /// that writes each frame's whole diagonal block and right-hand side before it adds to
-    /// them.
+    /// Sets the off-diagonal blocks to zero for the next system of the same size. The
+    /// diagonal blocks and the right-hand side are left as they are: the caller writes each
+    /// frame's whole (the trajectory's `frame_terms`) before it adds to them.
     pub fn clear_couplings(&mut self) {
+        // (Through the slices: nalgebra's `fill` walks a generic strided iterator.)
         for m in self.sub1.iter_mut().chain(&mut self.sub2) {
             m.as_mut_slice().fill(0.0);
         }
@@ -150,7 +142,8 @@ impl Banded {
         self.rhs.rows_mut(t * n, n)
     }
 
-    /// Factorises in place. The blocks are overwritten; [`Banded::clear`] starts again.
+    /// Factorises in place. The blocks are overwritten; [`Banded::clear_couplings`] and new
+    /// diagonal blocks start again.
     /// (The off-diagonal blocks are formed with the diagonal factors' inverses, products
     /// that run at matrix-multiply speed, where triangular solves by columns do not.)
     pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
