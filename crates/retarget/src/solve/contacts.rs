@@ -2,19 +2,17 @@
 //! ([`crate::contact_phases::detect`]), written to the output in both modes; the default
 //! solve plants the robot's feet on them.
 
-use super::prepare::Prepared;
-use crate::contact_phases::FootPoints;
+use fk::HumanMotion;
 
-impl Prepared<'_> {
-    /// The source's contact phases, where its feet were found (`feet`: by role, else by name).
-    pub(super) fn detect_contacts(
-        &mut self,
-        human: &fk::HumanMotion,
-        feet: Option<[FootPoints; 2]>,
-    ) {
-        if let Some(points) = feet {
-            let contact = &self.pipeline.contacts;
-            self.contacts = Some(crate::contact_phases::detect(human, points, contact));
-        }
-    }
+use crate::contact_phases::{ContactOptions, FootPoints};
+use crate::motion::FootContacts;
+
+/// The source's contact phases, where its feet were found (`feet`: by role, else by name;
+/// `None`: no contacts).
+pub(super) fn contacts(
+    human: &HumanMotion,
+    feet: Option<[FootPoints; 2]>,
+    options: &ContactOptions,
+) -> Option<FootContacts> {
+    feet.map(|points| crate::contact_phases::detect(human, points, options))
 }

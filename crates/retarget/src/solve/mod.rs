@@ -15,8 +15,9 @@
 //! parallel, each with a lead-in and a look-ahead. `--gmr` ([`SolveMode::Gmr`]) is stages 1,
 //! 2 and 5 with GMR's solver and nothing else. The mode is read once, by [`Pipeline::new`]
 //! (`pipeline.rs`): which stages run and with what options, what the stages read. A stage
-//! with something to say about the clip pushes a [`StageReport`] (named after its file:
-//! `treadmill`, `reweigh`) onto [`ClipDiagnostics::stages`].
+//! with something to say about the clip returns a [`StageReport`] (named after its file:
+//! `treadmill`, `reweigh`), which the driver collects, in the order the stages ran, into
+//! [`ClipDiagnostics::stages`].
 
 pub(crate) mod banded;
 mod contacts;
@@ -127,13 +128,14 @@ pub(crate) fn solve_clip(
     let human = walked.as_ref().map_or(human, |(walked, _)| walked);
     // 1. The targets.
     let mut prepared = Prepared::new(human, model, config, options, &pipeline, height)?;
-    prepared.reports.extend(walked.as_ref().map(|(_, report)| report.clone()));
     // 2. The source's contacts.
-    prepared.detect_contacts(human, feet);
+    prepared.contacts = contacts::contacts(human, feet, &pipeline.contacts);
     // 3. The foot plan.
     prepared.plan();
     // 4. Reweighing.
-    prepared.reweigh_where_planted()?;
+    let reweighed = prepared.reweigh_where_planted()?;
+    // What the stages that ran have to say, in order.
+    let reports = walked.as_ref().map(|(_, report)| report.clone()).into_iter().chain(reweighed);
     let start = Instant::now();
     // 5 and 6. The first pass and the trajectory solve, over the schedule.
     let n = prepared.num_frames();
@@ -141,7 +143,8 @@ pub(crate) fn solve_clip(
         None => schedule::solve_range(&prepared, 0..n, 0)?,
         Some(chunk) => schedule::solve_chunks(&prepared, chunk)?,
     };
-    Ok(prepared.finish(solved.qpos, solved.frames, start.elapsed().as_secs_f64()))
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(prepared.finish(reports.collect(), solved.qpos, solved.frames, seconds))
 }
 
 /// [`retarget_motion`] with the clip solved as chunks in parallel (rayon's current pool).

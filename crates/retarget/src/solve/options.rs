@@ -247,9 +247,9 @@ pub struct ClipDiagnostics {
 /// `default solve: `; Python gives them as `Motion.stages`, `{stage: {key: value}}` with the
 /// summary under `"summary"`.
 ///
-/// A stage that reports pushes one of these onto the solve's reports in its own file
-/// (`Prepared::reports`, as `solve/treadmill.rs` and `solve/reweigh.rs` do); the CLI, Python
-/// and [`ClipDiagnostics`] collect them without knowing the stage.
+/// A stage that reports returns one of these from its own file (as `solve/treadmill.rs`
+/// and `solve/reweigh.rs` do), and the driver (`solve_clip`) collects them in the order the
+/// stages ran; the CLI, Python and [`ClipDiagnostics`] show them without knowing the stage.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct StageReport {
     /// The stage's name: its file in `solve/` without `.rs` (`"treadmill"`, `"reweigh"`).

@@ -45,9 +45,6 @@ pub(crate) struct Prepared<'a> {
     pub(super) height: &'a SubjectHeight,
     /// Target slot of the human root.
     pub(super) root_target: usize,
-    /// What the stages that ran have to say, in order ([`ClipDiagnostics::stages`]): each
-    /// stage pushes its own [`StageReport`].
-    pub(super) reports: Vec<StageReport>,
 }
 
 /// Solved frames of a range.
@@ -96,7 +93,6 @@ impl<'a> Prepared<'a> {
             fps: human.fps,
             height,
             root_target: map.root,
-            reports: Vec::new(),
         };
         Ok(prepared)
     }
@@ -142,9 +138,11 @@ impl<'a> Prepared<'a> {
         &self.targets[f * self.slots..(f + 1) * self.slots]
     }
 
-    /// The clip's motion and diagnostics from its solved frames (all of them, in order).
+    /// The clip's motion and diagnostics from its solved frames (all of them, in order) and
+    /// what the stages that ran had to say, in order ([`ClipDiagnostics::stages`]).
     pub(crate) fn finish(
         &self,
+        reports: Vec<StageReport>,
         qpos: Vec<f64>,
         frames: Vec<FrameDiagnostics>,
         solve_seconds: f64,
@@ -197,7 +195,7 @@ impl<'a> Prepared<'a> {
             human_height_source: self.height.source.clone(),
             human_inferred: String::new(),
             solve_seconds,
-            stages: self.reports.clone(),
+            stages: reports,
         };
         (motion, diag)
     }

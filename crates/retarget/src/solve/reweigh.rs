@@ -22,16 +22,16 @@ use crate::Error;
 impl<'a> Prepared<'a> {
     /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
     /// ([`Prepared::pelvis_offset`], [`crate::PlausibleOptions::pelvis_offset_range`]).
-    /// Stage 4 (default solve, feet planted).
-    pub(super) fn reweigh_where_planted(&mut self) -> Result<(), Error> {
-        let Some(options) = self.pipeline.reweigh else { return Ok(()) };
+    /// Stage 4 (default solve, feet planted). Returns what it did, where it did anything.
+    pub(super) fn reweigh_where_planted(&mut self) -> Result<Option<StageReport>, Error> {
+        let Some(options) = self.pipeline.reweigh else { return Ok(None) };
         if self.plan.is_none() {
-            return Ok(());
+            return Ok(None);
         }
         self.reweigh(&options)
     }
 
-    fn reweigh(&mut self, options: &ReweighOptions) -> Result<(), Error> {
+    fn reweigh(&mut self, options: &ReweighOptions) -> Result<Option<StageReport>, Error> {
         // Only a root position weight above the cap holds the pelvis where the legs cannot
         // follow (GMR's G1 and H1 configs, 100; its T1, PM01 and ToddlerBot configs weigh it
         // 10, and doubling their trunk's and legs' rotation weights alone cost the PM01's
@@ -39,15 +39,14 @@ impl<'a> Prepared<'a> {
         let cap = options.root_position_weight_cap;
         let root = self.root_target;
         if !self.stages.iter().flatten().any(|t| t.target == root && t.pos_weight > cap) {
-            return Ok(());
+            return Ok(None);
         }
-        let Some(offset) = self.pelvis_offset()? else { return Ok(()) };
+        let Some(offset) = self.pelvis_offset()? else { return Ok(None) };
         let [from, to] = options.pelvis_offset_range;
         let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
         let share = t * t * (3.0 - 2.0 * t);
         reweigh(&mut self.stages, self.model, self.root_target, options, share);
-        self.reports.push(report(offset, share));
-        Ok(())
+        Ok(Some(report(offset, share)))
     }
 
     /// How far (m) the robot's pelvis stands above or below its target with the config's
