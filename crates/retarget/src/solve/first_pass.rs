@@ -15,12 +15,12 @@ use mjcf::{JointType, Model};
 use nalgebra::Vector3;
 
 use super::prepare::reject_divergence;
-use super::prepare::Prepared;
+use super::prepare::Problem;
 use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::Error;
 
-impl<'a> Prepared<'a> {
+impl<'a> Problem<'a> {
     /// The first pass over frames `frames` (forward; with [`crate::PlausibleOptions::both_ways`]
     /// also backward, on a second thread of rayon's pool, and spliced).
     pub(super) fn first_pass(
@@ -28,7 +28,7 @@ impl<'a> Prepared<'a> {
         solver: &mut Solver<'a>,
         frames: Range<usize>,
     ) -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
-        let nq = self.model.nq;
+        let nq = self.clip.model.nq;
         let (first, end) = (frames.start, frames.end);
         // Every constraint holds from the first pass on. (A first pass under box bounds only
         // is 1.4× faster on the G1, but on robots whose tracking drives links into each
@@ -44,7 +44,7 @@ impl<'a> Prepared<'a> {
                 }
                 Ok((qpos, out))
             };
-        if !self.pipeline.both_ways {
+        if !self.clip.pipeline.both_ways {
             return forward(solver);
         }
         // The two directions on two threads of rayon's pool (one, in a busy pool, is the same
@@ -52,7 +52,7 @@ impl<'a> Prepared<'a> {
         let (ahead, back) =
             rayon::join(|| forward(solver), || self.first_pass_backward(first..end));
         let ((mut qpos, mut out), (back, back_frames)) = (ahead?, back?);
-        let (coords, quats) = compared_coordinates(self.model);
+        let (coords, quats) = compared_coordinates(self.clip.model);
         splice_passes(nq, (&coords, &quats), &mut qpos, &mut out, &back, &back_frames);
         Ok((qpos, out))
     }
@@ -68,10 +68,10 @@ impl<'a> Prepared<'a> {
     ) -> Result<FrameDiagnostics, Error> {
         self.set_frame_tasks(solver, f)?;
         let targets = self.frame_targets(f);
-        let diagnostics = if first && !self.pipeline.is_gmr() {
-            solve_first_frame(self.model, solver, &self.tracked, targets)?
+        let diagnostics = if first && !self.clip.pipeline.is_gmr() {
+            solve_first_frame(self.clip.model, solver, &self.clip.tracked, targets)?
         } else {
-            solver.solve_frame(targets, first_frame_dt(first, self.frame_dt()))?
+            solver.solve_frame(targets, first_frame_dt(first, self.clip.frame_dt()))?
         };
         Ok(diagnostics)
     }
@@ -83,7 +83,7 @@ impl<'a> Prepared<'a> {
         range: Range<usize>,
     ) -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
         let mut solver = self.solver()?;
-        let nq = self.model.nq;
+        let nq = self.clip.model.nq;
         let mut qpos = vec![0.0; range.len() * nq];
         let mut frames = vec![FrameDiagnostics::default(); range.len()];
         for (k, f) in range.clone().enumerate().rev() {

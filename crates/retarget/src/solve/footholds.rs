@@ -10,30 +10,38 @@
 use mjcf::Model;
 use nalgebra::Vector3;
 
-use super::prepare::Prepared;
+use super::prepare::{Clip, PlannedFeet, Problem};
 use crate::feet::RobotFoot;
 use crate::ik::{GripPoint, PointTask, Solver, TaskSpec};
+use crate::lie::Pose;
+use crate::motion::FootContacts;
 use crate::Error;
 
-impl<'a> Prepared<'a> {
-    /// The default solve's foot plan, when it plants the feet: the robot's feet found and
-    /// planted on the source's contacts (when both the human's and the robot's feet are
-    /// found; otherwise the targets stay GMR's and only the constraints apply).
-    pub(super) fn plan(&mut self) {
-        let Some(options) = &self.pipeline.foot_plan else { return };
-        let feet = robot_feet(self.model, &self.stages);
-        let Some(contacts) = &self.contacts else { return };
-        let plan =
-            crate::feet::plan(&feet, contacts, &mut self.targets, self.slots, self.fps, options);
-        self.plan = Some((feet, plan));
-    }
+/// Stage 3, the default solve's foot plan, when it plants the feet: the robot's feet found
+/// (by `stages`, the tasks) and planted on the source's `contacts`; returns `targets` (all
+/// frames', `frames × slots`) with the feet's rewritten, and the plan. Without a plan (when
+/// the human's or the robot's feet are not found) the targets stay GMR's and only the
+/// constraints apply.
+pub(super) fn plan(
+    clip: &Clip<'_>,
+    stages: &[Vec<TaskSpec>],
+    contacts: Option<&FootContacts>,
+    mut targets: Vec<Pose>,
+) -> (Vec<Pose>, Option<PlannedFeet>) {
+    let Some(options) = &clip.pipeline.foot_plan else { return (targets, None) };
+    let feet = robot_feet(clip.model, stages);
+    let Some(contacts) = contacts else { return (targets, None) };
+    let plan = crate::feet::plan(&feet, contacts, &mut targets, clip.slots, clip.fps, options);
+    (targets, Some((feet, plan)))
+}
 
+impl Problem<'_> {
     /// Frame `f`'s foot weight factors and contact-point tasks (default mode).
     pub(super) fn set_frame_tasks(&self, solver: &mut Solver<'_>, f: usize) -> Result<(), Error> {
         self.set_frame_tasks_at(solver, f, None)
     }
 
-    /// [`Prepared::set_frame_tasks`]; with `at` (kinematics of the smoothed pose a repair
+    /// [`Problem::set_frame_tasks`]; with `at` (kinematics of the smoothed pose a repair
     /// starts from), also a vertical task, weighted as the contact points, that lifts each
     /// swing sole found below its swing clearance ([`crate::feet::FootPlan::swing_floor`]) back up to it.
     /// The smoothing filter pulls a swing foot towards its planted neighbours' height, the

@@ -1,5 +1,5 @@
-//! The default solve (and GMR's), stage by stage. [`retarget_motion`] is the plan: each
-//! stage is one file of this module, run in this order.
+//! The default solve (and GMR's), stage by stage. `solve_clip` (behind [`retarget_motion`])
+//! is the plan: each stage is one file of this module, run in this order.
 //!
 //! | # | stage | file | what it does | options |
 //! |---|---|---|---|---|
@@ -18,6 +18,23 @@
 //! with something to say about the clip returns a [`StageReport`] (named after its file:
 //! `treadmill`, `reweigh`), which the driver collects, in the order the stages ran, into
 //! [`ClipDiagnostics::stages`].
+//!
+//! The stages pass values; `solve_clip` names each one's output and hands it to the next:
+//!
+//! ```text
+//! human ─0 walk_off────► human (off its treadmill), its report
+//!       ─1 targets─────► Clip (what stays fixed: model, pipeline, rate, subject height,
+//!                        tracked bodies, target slots), the config's tasks, every frame's targets
+//!       ─2 contacts────► the source's contact phases
+//!       ─3 plan────────► the targets with the feet's planted, the foot plan
+//!                        → Problem { clip, tasks, targets, contacts, plan }
+//!       ─4 reweigh─────► the tasks reweighed and its report → the Problem with those tasks
+//!       ─5, 6 schedule─► qpos and each frame's diagnostics, from `&Problem`
+//!       → RobotMotion and ClipDiagnostics (`Problem::finish`, with the stages' reports)
+//! ```
+//!
+//! The solving stages (5 and 6: `first_pass.rs`, `windows.rs`, and the per-frame foot tasks
+//! in `footholds.rs`) read the `Problem` and change nothing in it.
 
 pub(crate) mod banded;
 mod contacts;
@@ -56,7 +73,7 @@ use crate::config::IkConfig;
 use crate::contact_phases::human_foot_points;
 use crate::motion::RobotMotion;
 use crate::Error;
-use prepare::Prepared;
+use prepare::Problem;
 
 /// Human FK of `bvh`, then [`retarget_motion`].
 pub fn retarget_bvh(
@@ -126,25 +143,30 @@ pub(crate) fn solve_clip(
         .filter(|_| pipeline.treadmill)
         .and_then(|feet| treadmill::walk_off(human, feet, &pipeline.contacts));
     let human = walked.as_ref().map_or(human, |(walked, _)| walked);
-    // 1. The targets.
-    let mut prepared = Prepared::new(human, model, config, options, &pipeline, height)?;
+    // 1. The targets: the clip, the config's tasks, every frame's targets.
+    let (clip, stages, targets) =
+        prepare::targets(human, model, config, options, &pipeline, height)?;
     // 2. The source's contacts.
-    prepared.contacts = contacts::contacts(human, feet, &pipeline.contacts);
-    // 3. The foot plan.
-    prepared.plan();
-    // 4. Reweighing.
-    let reweighed = prepared.reweigh_where_planted()?;
+    let contacts = contacts::contacts(human, feet, &pipeline.contacts);
+    // 3. The foot plan: the feet's targets planted on the contacts.
+    let (targets, plan) = footholds::plan(&clip, &stages, contacts.as_ref(), targets);
+    let problem = Problem { clip, stages, targets, contacts, plan };
+    // 4. Reweighing: the tasks, where the config's pelvis disagrees with the robot's legs.
+    let (problem, reweighed) = match reweigh::reweigh_where_planted(&problem)? {
+        Some((stages, report)) => (Problem { stages, ..problem }, Some(report)),
+        None => (problem, None),
+    };
     // What the stages that ran have to say, in order.
     let reports = walked.as_ref().map(|(_, report)| report.clone()).into_iter().chain(reweighed);
     let start = Instant::now();
-    // 5 and 6. The first pass and the trajectory solve, over the schedule.
-    let n = prepared.num_frames();
+    // 5 and 6. The first pass and the trajectory solve of the problem, over the schedule.
+    let n = problem.num_frames();
     let solved = match options.chunk {
-        None => schedule::solve_range(&prepared, 0..n, 0)?,
-        Some(chunk) => schedule::solve_chunks(&prepared, chunk)?,
+        None => schedule::solve_range(&problem, 0..n, 0)?,
+        Some(chunk) => schedule::solve_chunks(&problem, chunk)?,
     };
     let seconds = start.elapsed().as_secs_f64();
-    Ok(prepared.finish(reports.collect(), solved.qpos, solved.frames, seconds))
+    Ok(problem.finish(reports.collect(), solved.qpos, solved.frames, seconds))
 }
 
 /// [`retarget_motion`] with the clip solved as chunks in parallel (rayon's current pool).

@@ -57,7 +57,7 @@ pub struct PlausibleOptions {
     /// pelvis at the scaled human's height, 1.6–3.1 cm under where its legs put it.
     pub root_position_weight_cap: f64,
     /// How far (m) the robot's pelvis stands above or below its target, median over a few
-    /// windows of the clip solved with the config's weights (`Prepared::pelvis_offset`),
+    /// windows of the clip solved with the config's weights (`pelvis_offset`, `reweigh.rs`),
     /// over which the two changes above fade in (smoothstep from the first to the second).
     /// Measured where the root's position weight is above the cap: GMR's G1 config on the
     /// LAFAN1 walk / jumps 1.3 / 2.8 cm, its H1 config 5.0 / 3.5; our derived configs

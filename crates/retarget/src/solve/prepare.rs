@@ -1,5 +1,6 @@
-//! Stage 1, the targets: every frame's IK targets from the config (scaled, offset), the
-//! task setup, and what the later stages share ([`Prepared`]).
+//! Stage 1, the targets: every frame's IK targets from the config (scaled, offset) and the
+//! tasks ([`targets`]); and the values the stages pass on: the [`Clip`] stage 1 fixes, and
+//! the [`Problem`] the solving stages (5 and 6) solve.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in
@@ -24,27 +25,44 @@ use crate::targets::TargetMap;
 use crate::Error;
 use fk::HumanMotion;
 
-/// One clip made ready to solve: every frame's targets (foot-planned in the default mode),
-/// the source's contacts and the task setup. Solving frame ranges of it independently is
-/// how [`super::schedule`] parallelises a clip.
-pub(crate) struct Prepared<'a> {
-    // (The stages' files read and write these fields.)
+/// What stage 1 fixes of a clip for the rest of the solve: the robot, the stages that run,
+/// the frame rate, the subject's height, and how the targets are laid out.
+pub(crate) struct Clip<'a> {
     pub(super) model: &'a Model,
     /// The stages that run, and their options.
     pub(super) pipeline: &'a Pipeline,
-    pub(super) stages: Vec<Vec<TaskSpec>>,
-    /// `(body, target slot)` of each tracked body, as [`Solver::tracked`] orders them.
-    pub(super) tracked: Vec<(usize, usize)>,
-    pub(super) slots: usize,
-    /// `frames × slots` targets.
-    pub(super) targets: Vec<Pose>,
-    pub(super) contacts: Option<FootContacts>,
-    /// Foot bodies and per-frame weight factors (default mode).
-    pub(super) plan: Option<([Option<RobotFoot>; 2], FootPlan)>,
     pub(super) fps: f64,
     pub(super) height: &'a SubjectHeight,
+    /// `(body, target slot)` of each tracked body, as [`Solver::tracked`] orders them.
+    pub(super) tracked: Vec<(usize, usize)>,
+    /// Targets per frame.
+    pub(super) slots: usize,
     /// Target slot of the human root.
     pub(super) root_target: usize,
+}
+
+/// The solver's tasks, one list per IK stage of the config ([`task_specs`]).
+pub(crate) type Tasks = Vec<Vec<TaskSpec>>;
+
+/// The robot's two feet (those found) and the plan that plants them: stage 3's.
+pub(crate) type PlannedFeet = ([Option<RobotFoot>; 2], FootPlan);
+
+/// What the solving stages (5 and 6, over [`super::schedule`]) solve: the [`Clip`], the
+/// tasks, every frame's targets (foot-planned in the default mode), the source's contacts and
+/// the foot plan. The driver builds it from the earlier stages' outputs (stage 4's tasks in
+/// place of the config's where it reweighs them); the solving stages only read it. Solving
+/// frame ranges of it independently is how [`super::schedule`] parallelises a clip.
+pub(crate) struct Problem<'a> {
+    pub(super) clip: Clip<'a>,
+    /// The solver's tasks, one list per IK stage of the config (stage 1's; stage 4's where
+    /// it reweighs them).
+    pub(super) stages: Tasks,
+    /// `frames × slots` targets (stage 1's; stage 3 rewrites the feet's).
+    pub(super) targets: Vec<Pose>,
+    /// The source's contact phases (stage 2), where its feet were found.
+    pub(super) contacts: Option<FootContacts>,
+    /// Foot bodies and per-frame weight factors (stage 3, default mode).
+    pub(super) plan: Option<PlannedFeet>,
 }
 
 /// Solved frames of a range.
@@ -53,71 +71,39 @@ pub(crate) struct Solved {
     pub frames: Vec<FrameDiagnostics>,
 }
 
-impl<'a> Prepared<'a> {
-    pub(crate) fn new(
-        human: &HumanMotion,
-        model: &'a Model,
-        config: &IkConfig,
-        options: &RetargetOptions,
-        pipeline: &'a Pipeline,
-        height: &'a SubjectHeight,
-    ) -> Result<Prepared<'a>, Error> {
-        human.validate()?;
-        config.validate(model, &human.body_names)?;
-        let map = TargetMap::new(config, &human.body_names, height.metres)?;
-        let stages = task_specs(config, model, &map);
-        let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
-        let (nb, nf) = (human.num_bodies(), human.num_frames);
-        let slots = map.bodies.len();
-        let mut targets =
-            vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
-        for f in 0..nf {
-            let range = f * nb..(f + 1) * nb;
-            let out = &mut targets[f * slots..(f + 1) * slots];
-            map.compute(&human.positions[range.clone()], &human.orientations[range], out);
-            if let Some(bad) = out.iter().position(|p| !finite_pose(p)) {
-                let message =
-                    format!("target of human body `{}` is not finite", map.bodies[bad].name);
-                return Err(Error::Numerical { frame: f, message });
-            }
+/// Stage 1: the clip, the config's tasks (one list per IK stage of the config) and every
+/// frame's targets (`frames × slots`), from `human` seen by a subject `height` tall.
+pub(super) fn targets<'a>(
+    human: &HumanMotion,
+    model: &'a Model,
+    config: &IkConfig,
+    options: &RetargetOptions,
+    pipeline: &'a Pipeline,
+    height: &'a SubjectHeight,
+) -> Result<(Clip<'a>, Tasks, Vec<Pose>), Error> {
+    human.validate()?;
+    config.validate(model, &human.body_names)?;
+    let map = TargetMap::new(config, &human.body_names, height.metres)?;
+    let stages = task_specs(config, model, &map);
+    let tracked = Solver::new(model, &stages, options.solver.clone())?.tracked().to_vec();
+    let (nb, nf) = (human.num_bodies(), human.num_frames);
+    let slots = map.bodies.len();
+    let mut targets = vec![Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::zeros() }; nf * slots];
+    for f in 0..nf {
+        let range = f * nb..(f + 1) * nb;
+        let out = &mut targets[f * slots..(f + 1) * slots];
+        map.compute(&human.positions[range.clone()], &human.orientations[range], out);
+        if let Some(bad) = out.iter().position(|p| !finite_pose(p)) {
+            let message = format!("target of human body `{}` is not finite", map.bodies[bad].name);
+            return Err(Error::Numerical { frame: f, message });
         }
-        let prepared = Prepared {
-            model,
-            pipeline,
-            stages,
-            tracked,
-            slots,
-            targets,
-            contacts: None,
-            plan: None,
-            fps: human.fps,
-            height,
-            root_target: map.root,
-        };
-        Ok(prepared)
     }
+    let clip =
+        Clip { model, pipeline, fps: human.fps, height, tracked, slots, root_target: map.root };
+    Ok((clip, stages, targets))
+}
 
-    /// The robot body a task follows the human root's target with.
-    pub(super) fn root_body(&self) -> Option<usize> {
-        self.stages.iter().flatten().find(|t| t.target == self.root_target).map(|t| t.body)
-    }
-
-    /// The contact points' weight ([`crate::FootPlanOptions::contact_weight`]; 0 without a
-    /// foot plan).
-    pub(super) fn contact_weight(&self) -> f64 {
-        self.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.contact_weight)
-    }
-
-    /// How fast a planted sole's points may slide ([`crate::FootPlanOptions::slip_speed`]).
-    pub(super) fn grip_slip_speed(&self) -> f64 {
-        self.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.slip_speed)
-    }
-
-    /// A solver for this clip: GMR's, or with the default mode's constraints.
-    pub(super) fn solver(&self) -> Result<Solver<'a>, Error> {
-        build_solver(self.model, &self.stages, self.pipeline)
-    }
-
+impl Clip<'_> {
     /// Seconds between frames (0 for a clip without a rate).
     pub(super) fn frame_dt(&self) -> f64 {
         if self.fps > 0.0 {
@@ -133,9 +119,34 @@ impl<'a> Prepared<'a> {
         let fps = if self.fps > 0.0 { self.fps } else { 30.0 };
         (seconds * fps).round().max(0.0) as usize
     }
+}
+
+impl<'a> Problem<'a> {
+    /// The robot body a task follows the human root's target with.
+    pub(super) fn root_body(&self) -> Option<usize> {
+        let root = self.clip.root_target;
+        self.stages.iter().flatten().find(|t| t.target == root).map(|t| t.body)
+    }
+
+    /// The contact points' weight ([`crate::FootPlanOptions::contact_weight`]; 0 without a
+    /// foot plan).
+    pub(super) fn contact_weight(&self) -> f64 {
+        self.clip.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.contact_weight)
+    }
+
+    /// How fast a planted sole's points may slide ([`crate::FootPlanOptions::slip_speed`]).
+    pub(super) fn grip_slip_speed(&self) -> f64 {
+        self.clip.pipeline.foot_plan.as_ref().map_or(0.0, |f| f.slip_speed)
+    }
+
+    /// A solver for this problem: GMR's, or with the default mode's constraints.
+    pub(super) fn solver(&self) -> Result<Solver<'a>, Error> {
+        build_solver(self.clip.model, &self.stages, self.clip.pipeline)
+    }
 
     pub(super) fn frame_targets(&self, f: usize) -> &[Pose] {
-        &self.targets[f * self.slots..(f + 1) * self.slots]
+        let slots = self.clip.slots;
+        &self.targets[f * slots..(f + 1) * slots]
     }
 
     /// The clip's motion and diagnostics from its solved frames (all of them, in order) and
@@ -147,22 +158,23 @@ impl<'a> Prepared<'a> {
         frames: Vec<FrameDiagnostics>,
         solve_seconds: f64,
     ) -> (RobotMotion, ClipDiagnostics) {
-        let model = self.model;
+        let clip = &self.clip;
+        let model = clip.model;
         let nf = frames.len();
-        let mut target_pos = Vec::with_capacity(nf * self.tracked.len());
-        let mut target_quat = Vec::with_capacity(nf * self.tracked.len());
+        let mut target_pos = Vec::with_capacity(nf * clip.tracked.len());
+        let mut target_quat = Vec::with_capacity(nf * clip.tracked.len());
         for f in 0..nf {
-            for &(_, t) in &self.tracked {
-                let p = &self.targets[f * self.slots + t];
+            for &(_, t) in &clip.tracked {
+                let p = &self.targets[f * clip.slots + t];
                 target_pos.push(p.pos);
                 let q = nalgebra::Quaternion::new(p.quat[0], p.quat[1], p.quat[2], p.quat[3]);
                 target_quat.push(UnitQuaternion::new_unchecked(q));
             }
         }
         let body_name = |b: usize| model.bodies[b].name.clone();
-        let tracked_names: Vec<String> = self.tracked.iter().map(|&(b, _)| body_name(b)).collect();
+        let tracked_names: Vec<String> = clip.tracked.iter().map(|&(b, _)| body_name(b)).collect();
         let motion = RobotMotion {
-            fps: self.fps,
+            fps: clip.fps,
             nq: model.nq,
             qpos,
             joint_names: RobotMotion::model_joint_names(model),
@@ -180,19 +192,19 @@ impl<'a> Prepared<'a> {
         };
         let diag = ClipDiagnostics {
             body_names: tracked_names,
-            position_tracked: self
+            position_tracked: clip
                 .tracked
                 .iter()
                 .map(|&(b, _)| weighted(b, |t| t.pos_weight))
                 .collect(),
-            rotation_tracked: self
+            rotation_tracked: clip
                 .tracked
                 .iter()
                 .map(|&(b, _)| weighted(b, |t| t.rot_weight))
                 .collect(),
             frames,
-            human_height: self.height.metres,
-            human_height_source: self.height.source.clone(),
+            human_height: clip.height.metres,
+            human_height_source: clip.height.source.clone(),
             human_inferred: String::new(),
             solve_seconds,
             stages: reports,
@@ -201,11 +213,11 @@ impl<'a> Prepared<'a> {
     }
 
     pub(crate) fn num_frames(&self) -> usize {
-        self.targets.len().checked_div(self.slots).unwrap_or(0)
+        self.targets.len().checked_div(self.clip.slots).unwrap_or(0)
     }
 }
 
-impl crate::solve::trajectory::Frames for Prepared<'_> {
+impl crate::solve::trajectory::Frames for Problem<'_> {
     fn targets(&self, frame: usize) -> &[Pose] {
         self.frame_targets(frame)
     }
@@ -215,9 +227,9 @@ impl crate::solve::trajectory::Frames for Prepared<'_> {
     }
 
     fn root_reference(&self, frame: usize) -> Option<(Pose, bool)> {
-        let free = self.model.joints.iter().find(|j| j.kind == JointType::Free)?;
+        let free = self.clip.model.joints.iter().find(|j| j.kind == JointType::Free)?;
         let body = self.root_body()?;
-        Some((self.frame_targets(frame)[self.root_target], body == free.body))
+        Some((self.frame_targets(frame)[self.clip.root_target], body == free.body))
     }
 }
 

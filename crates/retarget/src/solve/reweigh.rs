@@ -14,85 +14,82 @@ use std::ops::Range;
 use mjcf::Model;
 
 use super::pipeline::ReweighOptions;
-use super::prepare::Prepared;
+use super::prepare::{Problem, Tasks};
 use super::{StageReport, StageValue};
 use crate::ik::TaskSpec;
 use crate::Error;
 
-impl<'a> Prepared<'a> {
-    /// [`reweigh`]s the tasks by how far the robot's pelvis stands from its target
-    /// ([`Prepared::pelvis_offset`], [`crate::PlausibleOptions::pelvis_offset_range`]).
-    /// Stage 4 (default solve, feet planted). Returns what it did, where it did anything.
-    pub(super) fn reweigh_where_planted(&mut self) -> Result<Option<StageReport>, Error> {
-        let Some(options) = self.pipeline.reweigh else { return Ok(None) };
-        if self.plan.is_none() {
-            return Ok(None);
-        }
-        self.reweigh(&options)
+/// Stage 4 (default solve, feet planted): `problem`'s tasks [`reweigh`]ed by how far the
+/// robot's pelvis stands from its target with them ([`pelvis_offset`],
+/// [`crate::PlausibleOptions::pelvis_offset_range`]), and what was done; `None` where the
+/// stage does not run, or the config does not pin the pelvis (the tasks stay the config's).
+pub(super) fn reweigh_where_planted(
+    problem: &Problem<'_>,
+) -> Result<Option<(Tasks, StageReport)>, Error> {
+    let Some(options) = problem.clip.pipeline.reweigh else { return Ok(None) };
+    if problem.plan.is_none() {
+        return Ok(None);
     }
-
-    fn reweigh(&mut self, options: &ReweighOptions) -> Result<Option<StageReport>, Error> {
-        // Only a root position weight above the cap holds the pelvis where the legs cannot
-        // follow (GMR's G1 and H1 configs, 100; its T1, PM01 and ToddlerBot configs weigh it
-        // 10, and doubling their trunk's and legs' rotation weights alone cost the PM01's
-        // jumps position, 1.07× → 1.14× `--gmr`'s).
-        let cap = options.root_position_weight_cap;
-        let root = self.root_target;
-        if !self.stages.iter().flatten().any(|t| t.target == root && t.pos_weight > cap) {
-            return Ok(None);
-        }
-        let Some(offset) = self.pelvis_offset()? else { return Ok(None) };
-        let [from, to] = options.pelvis_offset_range;
-        let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
-        let share = t * t * (3.0 - 2.0 * t);
-        reweigh(&mut self.stages, self.model, self.root_target, options, share);
-        Ok(Some(report(offset, share)))
+    // Only a root position weight above the cap holds the pelvis where the legs cannot
+    // follow (GMR's G1 and H1 configs, 100; its T1, PM01 and ToddlerBot configs weigh it
+    // 10, and doubling their trunk's and legs' rotation weights alone cost the PM01's
+    // jumps position, 1.07× → 1.14× `--gmr`'s).
+    let cap = options.root_position_weight_cap;
+    let root = problem.clip.root_target;
+    if !problem.stages.iter().flatten().any(|t| t.target == root && t.pos_weight > cap) {
+        return Ok(None);
     }
+    let Some(offset) = pelvis_offset(problem)? else { return Ok(None) };
+    let [from, to] = options.pelvis_offset_range;
+    let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
+    let share = t * t * (3.0 - 2.0 * t);
+    let mut stages = problem.stages.clone();
+    reweigh(&mut stages, problem.clip.model, root, &options, share);
+    Ok(Some((stages, report(offset, share))))
+}
 
-    /// How far (m) the robot's pelvis stands above or below its target with the config's
-    /// weights: the median height difference over [`PELVIS_WINDOWS`] windows of
-    /// [`PELVIS_WINDOW_S`] (at a quarter, half and three quarters of the clip, or the
-    /// whole of a shorter clip), each solved from its first frame as a clip is, its first
-    /// frames left out. Height only: the horizontal offsets follow the direction of travel
-    /// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). `None` when no task
-    /// tracks the root's position.
-    fn pelvis_offset(&self) -> Result<Option<f64>, Error> {
-        let root = self
-            .stages
-            .iter()
-            .flatten()
-            .find(|t| t.target == self.root_target && t.pos_weight > 0.0);
-        let Some(body) = root.map(|t| t.body) else { return Ok(None) };
-        let frames = self.num_frames();
-        let (window_frames, settle) =
-            (self.frames_in(PELVIS_WINDOW_S).max(1), self.frames_in(PELVIS_SETTLE_S));
-        let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * window_frames {
-            std::iter::once(0..frames).collect()
-        } else {
-            (1..=PELVIS_WINDOWS)
-                .map(|k| {
-                    let start = frames * k / (PELVIS_WINDOWS + 1) - window_frames / 2;
-                    start..start + window_frames
-                })
-                .collect()
-        };
-        let mut solver = self.solver()?;
-        let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
-        for window in windows {
-            for f in window.clone() {
-                self.first_pass_frame(&mut solver, f, f == window.start)?;
-                if f >= window.start + settle || window.len() <= settle {
-                    let target = &self.frame_targets(f)[self.root_target];
-                    heights.push(solver.data().xpos[body].z - target.pos.z);
-                }
+/// How far (m) the robot's pelvis stands above or below its target with `problem`'s
+/// weights: the median height difference over [`PELVIS_WINDOWS`] windows of
+/// [`PELVIS_WINDOW_S`] (at a quarter, half and three quarters of the clip, or the
+/// whole of a shorter clip), each solved from its first frame as a clip is, its first
+/// frames left out. Height only: the horizontal offsets follow the direction of travel
+/// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). `None` when no task
+/// tracks the root's position.
+fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
+    let root_target = problem.clip.root_target;
+    let root =
+        problem.stages.iter().flatten().find(|t| t.target == root_target && t.pos_weight > 0.0);
+    let Some(body) = root.map(|t| t.body) else { return Ok(None) };
+    let frames = problem.num_frames();
+    let clip = &problem.clip;
+    let (window_frames, settle) =
+        (clip.frames_in(PELVIS_WINDOW_S).max(1), clip.frames_in(PELVIS_SETTLE_S));
+    let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * window_frames {
+        std::iter::once(0..frames).collect()
+    } else {
+        (1..=PELVIS_WINDOWS)
+            .map(|k| {
+                let start = frames * k / (PELVIS_WINDOWS + 1) - window_frames / 2;
+                start..start + window_frames
+            })
+            .collect()
+    };
+    let mut solver = problem.solver()?;
+    let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
+    for window in windows {
+        for f in window.clone() {
+            problem.first_pass_frame(&mut solver, f, f == window.start)?;
+            if f >= window.start + settle || window.len() <= settle {
+                let target = &problem.frame_targets(f)[root_target];
+                heights.push(solver.data().xpos[body].z - target.pos.z);
             }
         }
-        if heights.is_empty() {
-            return Ok(None);
-        }
-        let median = crate::report::percentile(&heights, 0.5);
-        Ok(Some(median.abs()))
     }
+    if heights.is_empty() {
+        return Ok(None);
+    }
+    let median = crate::report::percentile(&heights, 0.5);
+    Ok(Some(median.abs()))
 }
 
 /// What the reweighing says of a clip whose pelvis stood `offset` (m) above or below its
@@ -115,7 +112,7 @@ fn report(offset: f64, share: f64) -> StageReport {
 }
 
 /// Windows of a clip solved to measure how far the pelvis stands from its target
-/// ([`Prepared::pelvis_offset`]), their length (s), and the time at the start of each left
+/// ([`pelvis_offset`]), their length (s), and the time at the start of each left
 /// out (s; the solve settles from its start pose). 30 and 5 frames at 30 fps.
 const PELVIS_WINDOWS: usize = 3;
 const PELVIS_WINDOW_S: f64 = 1.0;

@@ -18,29 +18,29 @@ use std::ops::Range;
 use mjcf::Model;
 use rayon::prelude::*;
 
-use super::prepare::{Prepared, Solved};
+use super::prepare::{Problem, Solved};
 use super::ChunkOptions;
 use crate::Error;
 
-/// Frames `range` of `prepared` through stages 5 and 6, from `qpos0` at `range.start −
+/// Frames `range` of `problem` through stages 5 and 6, from `qpos0` at `range.start −
 /// lead_in` (the lead-in's frames are solved and dropped) to a window's overlap past its end
 /// (the trajectory solve's last frames need the frames after them in view).
 pub(super) fn solve_range(
-    prepared: &Prepared<'_>,
+    problem: &Problem<'_>,
     range: Range<usize>,
     lead_in: usize,
 ) -> Result<Solved, Error> {
-    let nq = prepared.model.nq;
+    let nq = problem.clip.model.nq;
     let first = range.start.saturating_sub(lead_in);
-    let trajectory = prepared.pipeline.trajectory.as_ref();
-    let ahead = trajectory.map_or(0, |t| super::trajectory::overlap_frames(t, prepared.fps));
-    let end = (range.end + ahead).min(prepared.num_frames());
-    let mut solver = prepared.solver()?;
+    let trajectory = problem.clip.pipeline.trajectory.as_ref();
+    let ahead = trajectory.map_or(0, |t| super::trajectory::overlap_frames(t, problem.clip.fps));
+    let end = (range.end + ahead).min(problem.num_frames());
+    let mut solver = problem.solver()?;
     // 5. The first pass.
-    let (mut qpos, mut frames) = prepared.first_pass(&mut solver, first..end)?;
+    let (mut qpos, mut frames) = problem.first_pass(&mut solver, first..end)?;
     // 6. The trajectory solve.
     if let (Some(options), false) = (trajectory, qpos.is_empty()) {
-        prepared.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
+        problem.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
     }
     let skip = range.start - first;
     qpos.truncate((range.end - first) * nq);
@@ -48,20 +48,20 @@ pub(super) fn solve_range(
     Ok(Solved { qpos: qpos.split_off(skip * nq), frames: frames.split_off(skip) })
 }
 
-/// Frames `0..n` of `prepared` solved as chunks on rayon's current pool (stages 5 and 6 of
+/// Frames `0..n` of `problem` solved as chunks on rayon's current pool (stages 5 and 6 of
 /// each, [`solve_range`]) and stitched, each chunk's quaternions continued across
 /// its seam.
-pub(super) fn solve_chunks(prepared: &Prepared<'_>, chunk: ChunkOptions) -> Result<Solved, Error> {
+pub(super) fn solve_chunks(problem: &Problem<'_>, chunk: ChunkOptions) -> Result<Solved, Error> {
     if chunk.frames == 0 {
         let name = "chunk frames".to_owned();
         return Err(Error::InvalidOption { name, value: 0.0, expected: "at least one frame" });
     }
-    let model = prepared.model;
-    let n = prepared.num_frames();
+    let model = problem.clip.model;
+    let n = problem.num_frames();
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
     let parts = starts
         .par_iter()
-        .map(|&start| solve_range(prepared, start..(start + chunk.frames).min(n), chunk.lead_in))
+        .map(|&start| solve_range(problem, start..(start + chunk.frames).min(n), chunk.lead_in))
         .collect::<Result<Vec<Solved>, Error>>()?;
     let mut solved =
         Solved { qpos: Vec::with_capacity(n * model.nq), frames: Vec::with_capacity(n) };

@@ -6,11 +6,11 @@
 // `HumanMotion::validate` first.
 #![allow(clippy::indexing_slicing)]
 
-use super::prepare::Prepared;
+use super::prepare::Problem;
 use crate::ik::{FrameDiagnostics, Solver};
 use crate::Error;
 
-impl<'a> Prepared<'a> {
+impl<'a> Problem<'a> {
     /// The trajectory solve ([`crate::solve::trajectory`]) of frames `first..` (`qpos`, the
     /// first pass's, in and out), window after window.
     pub(super) fn solve_trajectory(
@@ -21,10 +21,11 @@ impl<'a> Prepared<'a> {
         qpos: &mut [f64],
         frames: &mut [FrameDiagnostics],
     ) -> Result<(), Error> {
-        let nq = self.model.nq;
+        let nq = self.clip.model.nq;
         let n = frames.len();
+        let (stages, fps) = (self.stages.len(), self.clip.fps);
         let mut trajectory =
-            crate::solve::trajectory::Trajectory::new(solver, self.stages.len(), options, self.fps);
+            crate::solve::trajectory::Trajectory::new(solver, stages, options, fps);
         let (window, overlap) = trajectory.window_frames();
         let mut start = 0;
         let mut fixed: Vec<Vec<f64>> = Vec::new();
