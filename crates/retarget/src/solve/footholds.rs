@@ -1,5 +1,7 @@
-//! Stage 3, the foot plan: the robot's feet, and each frame's planted sole points, foot
-//! weights and swing floors from the source's contacts ([`crate::feet`]).
+//! Stage 3, the foot plan ([`plan`]): the robot's feet, and each frame's planted sole points,
+//! foot weights and swing floors from the source's contacts ([`crate::feet`]). Also what
+//! the solving stages (5 and 6) ask of the plan: a frame's foot tasks set on the solver
+//! ([`Problem::set_frame_tasks`]).
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in
