@@ -292,3 +292,41 @@ fn a_gripped_sole_point_slides_no_faster_than_the_slip_speed() {
     let landing = moved(Some(None));
     assert!((landing - free).norm() < 1e-12, "a first planted frame is not held");
 }
+
+#[test]
+fn a_trajectory_step_that_ends_inside_another_geom_steps_out() {
+    // A ball on a rail pulled towards a point 10 cm past a post's centre, from 40 cm
+    // away: no row holds them apart where the step starts (further than the
+    // self-collision's activation), and the step alone ends deep in the post.
+    let model = Model::from_xml_str(
+        r#"<mujoco><worldbody><body name="base">
+             <geom name="base" size="0.02" pos="0 0 -1"/>
+             <body name="ball"><joint type="slide" axis="1 0 0" range="-1 1"/><geom name="ball" size="0.05"/></body>
+             <body name="post" pos="0.5 0 0"><geom name="post" size="0.05"/></body>
+           </body></worldbody></mujoco>"#,
+        None,
+    )
+    .unwrap();
+    let ball = model.body_id("ball").unwrap();
+    let (g_ball, g_post) = (1, 2);
+    let tasks = vec![TaskSpec { body: ball, target: 0, pos_weight: 1.0, rot_weight: 0.0 }];
+    let target = Pose { quat: [1.0, 0.0, 0.0, 0.0], pos: Vector3::new(0.6, 0.0, 0.0) };
+    let depth = |with_constraint: bool| {
+        let mut options = SolverOptions::default();
+        options.damping = 1e-6;
+        let mut solver = Solver::new(&model, std::slice::from_ref(&tasks), options).unwrap();
+        if with_constraint {
+            let collision = retarget::internals::SelfCollision::new(&model);
+            solver.add_constraint(Box::new(collision));
+        }
+        solver.set_qpos(&[0.0]).unwrap();
+        solver.trajectory_step(&[(0, 1.0)], &[target], 1.0 / 30.0).unwrap();
+        let mut data = Data::new(&model);
+        model.kinematics(solver.qpos(), &mut data);
+        -mjcf::geom_distance(&model, &data, g_ball, g_post, 1.0).unwrap().distance
+    };
+    let free = depth(false);
+    assert!(free > 0.03, "without the constraint the ball ends {free} m deep");
+    let held = depth(true);
+    assert!(held < 1e-3, "the step ends {held} m deep in the post");
+}
