@@ -5,8 +5,9 @@
 //!   robot's SMPL-X config (GMR's `smplx_to_*.json`, [`crate::shipped::smplx_config`]):
 //!   every SMPL-X and SMPL+H body model has smplx's joint names and the same joint frames
 //!   (the template's T-pose, Y up, facing +Z), which those configs are written for, so they
-//!   fit any SMPL source; else one derived from the robot's roles and the body's
-//!   ([`crate::derive::derive`]).
+//!   fit any SMPL source, unless the default solve finds it contradicting the robot's joint
+//!   frames ([`crate::derive::contradiction`]); else one derived from the robot's roles and
+//!   the body's ([`crate::derive::derive`]).
 //! - **Default solve**: the body model's FK at the file's rate ([`smpl::clip`]), its
 //!   recognised roles (the contacts read the `foot` and `toe` roles: `left_ankle`,
 //!   `left_foot`), the model's stature as the subject height.
@@ -39,6 +40,7 @@ pub fn choose(
     clip: &smpl::Clip,
     given: Option<IkConfig>,
     tuned: Option<&IkConfig>,
+    gmr: bool,
 ) -> Result<Chosen, Error> {
     let names = &clip.human.body_names;
     if let Some(config) = given {
@@ -51,16 +53,29 @@ pub fn choose(
         let summary = format!("config {} (role-named), bound to the body model", config.source);
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }
-    if let Some(tuned) = tuned {
-        if tuned.validate(model, names).is_ok() {
-            let summary = format!("config {} (tuned: SMPL joint names and frames)", tuned.source);
-            return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-        }
-    }
     let roles = RobotRoles::recognise(model)?;
     let source = format!("<derived for {robot}>");
     let derived = crate::derive::derive(model, &roles, &human_body(clip)?, &source)?;
-    let summary = format!("config derived from the roles of {robot} and of the body model");
+    let mut why_not = String::new();
+    if let Some(tuned) = tuned.filter(|t| t.validate(model, names).is_ok()) {
+        // (`--gmr` takes GMR's config as GMR does.)
+        match crate::derive::contradiction(tuned, &derived, &roles).filter(|_| !gmr) {
+            None => {
+                let summary =
+                    format!("config {} (tuned: SMPL joint names and frames)", tuned.source);
+                return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
+            }
+            Some((body, angle)) => {
+                why_not = format!(
+                    " (not the tuned {}: it turns {body} {:.0}° from the robot's joint frames)",
+                    tuned.source,
+                    angle.to_degrees()
+                );
+            }
+        }
+    }
+    let summary =
+        format!("config derived from the roles of {robot} and of the body model{why_not}");
     Ok(Chosen { config: derived, choice: Choice::Derived, summary })
 }
 
@@ -85,7 +100,9 @@ pub fn frames_from(human: &HumanMotion, from: usize) -> HumanMotion {
 impl Retargeter {
     /// The config an SMPL clip is retargeted with, and why.
     pub fn choose_smpl_config(&self, clip: &smpl::Clip) -> Result<Chosen, Error> {
-        choose(self.model(), self.label(), clip, self.given_config().cloned(), self.smplx_config())
+        let gmr = crate::solve::Pipeline::new(self.options()).is_gmr();
+        let (given, tuned) = (self.given_config().cloned(), self.smplx_config());
+        choose(self.model(), self.label(), clip, given, tuned, gmr)
     }
 
     /// Retargets an SMPL-X or SMPL+H motion posed with `body` (module docs: what each mode

@@ -389,3 +389,28 @@ fn the_scaled_feet_stand_as_wide_as_the_robots() {
         assert!(median > 0.85 * stand, "{key}: {median:.3} m apart, {stand:.3} m at qpos0");
     }
 }
+
+#[test]
+fn a_tuned_config_that_turns_a_knee_over_contradicts_the_robot() {
+    let (model, _) = shipped("unitree_g1");
+    let roles = RobotRoles::recognise(&model).unwrap();
+    let human = HumanBody::canonical();
+    let derived = derive::derive(&model, &roles, &human, "derived").unwrap();
+    assert_eq!(derive::contradiction(&derived, &derived, &roles), None);
+    // A copy with one knee's rotation offset turned half a turn about its own z, and one
+    // with a hand's: the knee contradicts the robot's joint frames, the hand is not asked.
+    let knee = roles.roles[&Role::LeftShin].name.clone();
+    let hand = roles.roles[&Role::LeftHand].name.clone();
+    let turned = |body: &str, angle: f64| {
+        let mut config = derived.clone();
+        let entry = config.ik_match_table1.iter_mut().find(|e| e.robot_body == body).unwrap();
+        let turn = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), angle);
+        entry.rot_offset *= turn;
+        config
+    };
+    let (body, angle) = derive::contradiction(&turned(&knee, 3.0), &derived, &roles).unwrap();
+    assert_eq!(body, knee);
+    assert!((angle - 3.0).abs() < 1e-9, "{angle}");
+    assert_eq!(derive::contradiction(&turned(&knee, 1.4), &derived, &roles), None);
+    assert_eq!(derive::contradiction(&turned(&hand, 3.0), &derived, &roles), None);
+}

@@ -385,7 +385,8 @@ pub fn human_body(bvh: &bvh::Bvh, fk: &fk::FkOptions, source: &str) -> Result<Hu
 ///   skeleton has its human body names and LAFAN1's joint frames ([`JointFrames::differs`]:
 ///   a property of the skeleton, whatever the motion), with or without `gmr` (`--gmr`: GMR
 ///   takes it on any skeleton with the names, but its rotation offsets hold only for those
-///   frames; GMR stops with a `KeyError` on other names);
+///   frames; GMR stops with a `KeyError` on other names), and, in the default solve, when it
+///   agrees with the robot's joint frames ([`contradiction`]);
 /// - otherwise the config derived from the robot's and the skeleton's roles.
 ///
 /// `robot` names the robot in messages.
@@ -428,7 +429,21 @@ pub fn choose(
             // in a T zero pose stood on its head with them), so `--gmr` asks the same.
             let humanoid = fk::recognise(bvh, &fk_options.roles)?;
             let frames = LAFAN1_FRAMES;
-            match frames.differs(&humanoid, fk_options.axes) {
+            // The default solve also asks that it agree with the robot's joint frames.
+            let reason = match frames.differs(&humanoid, fk_options.axes) {
+                Some(reason) => Some(format!("the skeleton has its names, but {reason}")),
+                None if gmr => None,
+                None => {
+                    let roles = RobotRoles::recognise(model)?;
+                    let human = human_body(bvh, fk_options, "the skeleton")?;
+                    let derived = derive(model, &roles, &human, "")?;
+                    contradiction(tuned, &derived, &roles).map(|(body, angle)| {
+                        let degrees = angle.to_degrees();
+                        format!("it turns {body} {degrees:.0}° from the robot's joint frames")
+                    })
+                }
+            };
+            match reason {
                 None => {
                     let summary = format!(
                         "config {} (tuned: the skeleton has its names and {}'s joint frames{solve})",
@@ -437,10 +452,7 @@ pub fn choose(
                     return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
                 }
                 Some(reason) => {
-                    why_not = format!(
-                        " (not the tuned {}: the skeleton has its names, but {reason}{solve})",
-                        tuned.source
-                    );
+                    why_not = format!(" (not the tuned {}: {reason}{solve})", tuned.source);
                 }
             }
         }
@@ -457,4 +469,48 @@ pub fn choose(
 #[must_use]
 pub fn active_entries(config: &IkConfig) -> Vec<&MatchEntry> {
     config.ik_match_table1.iter().filter(|e| e.is_active()).collect()
+}
+
+/// The parts of the body that carry the robot: a tuned config must agree with the robot's
+/// joint frames on these ([`contradiction`]).
+const CARRYING: [Part; 7] =
+    [Part::Pelvis, Part::Spine, Part::Chest, Part::Thigh, Part::Shin, Part::Foot, Part::Toe];
+
+/// A tuned config's rotation offset further than this (rad) from the derived config's for
+/// the same robot and human bodies turns the body against the robot's joint frames: no
+/// tuning turns a knee more than a quarter turn. (GMR's `smplx_to_bhl.json` turns the
+/// Berkeley Humanoid Lite's left knee 178.6° from them, its right knee 6.5°: the default
+/// solve's root accelerated 2.6–3.4 × the scaled human's on AMASS walks, 1.0 × with the
+/// derived config.) Arms are left out: a servo shoulder's derived offsets turn the human's
+/// arm frames (`shoulder::arm_turns`), ToddlerBot's hands by 94–150°.
+pub const CONTRADICTS: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Where the `tuned` config contradicts the robot's joint frames (as the `derived` config
+/// for the same source has them): its row for a body of a [`CARRYING`] part whose rotation
+/// offset is more than [`CONTRADICTS`] from the derived one's (same robot and human body,
+/// both with a rotation weight), the furthest, as `(robot body, angle in rad)`.
+#[must_use]
+pub fn contradiction(
+    tuned: &IkConfig,
+    derived: &IkConfig,
+    roles: &RobotRoles,
+) -> Option<(String, f64)> {
+    let carrying = |body: &str| {
+        roles.roles.iter().any(|(role, r)| r.name == body && CARRYING.contains(&role.part()))
+    };
+    let rotated = |c: &IkConfig| -> Vec<MatchEntry> {
+        c.ik_match_table1.iter().filter(|e| e.rot_weight > 0.0).cloned().collect()
+    };
+    let derived = rotated(derived);
+    rotated(tuned)
+        .into_iter()
+        .filter(|t| carrying(&t.robot_body))
+        .filter_map(|t| {
+            let d = derived
+                .iter()
+                .find(|d| d.robot_body == t.robot_body && d.human_body == t.human_body)?;
+            Some((t.robot_body.clone(), t.rot_offset.angle_to(&d.rot_offset)))
+        })
+        .filter(|(_, angle)| *angle > CONTRADICTS)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
 }
