@@ -623,17 +623,6 @@ impl<'m> Solver<'m> {
         }
     }
 
-    /// Mirrors H's upper triangle (where the terms are added) into the lower one, for the
-    /// box solver, which reads whole rows ([`DenseQp`] reads the upper triangle).
-    fn mirror_hessian(&mut self) {
-        let nv = self.model.nv;
-        for d in 0..nv {
-            for e in 0..d {
-                self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
-            }
-        }
-    }
-
     /// Moves by `self.dq` (and counts it in `moved`) and updates the kinematics. Without
     /// constraints nothing in a step reads the geoms and sites: they are placed once the
     /// frame is solved ([`Solver::place_geoms`]).
@@ -687,7 +676,7 @@ impl<'m> Solver<'m> {
             let col: [f64; 6] = std::array::from_fn(|r| task.wjac[r][a]);
             self.qp.c[da] -= dot6(&we, &col);
         }
-        // Upper triangle only (dofs ascending); mirrored for the box solver.
+        // Upper triangle only (dofs ascending), which is what both QP solvers read.
         task_terms::add_gram(&task.wjac, &w, &task.dofs, &task.runs, nv, &mut self.qp.h);
         self.options.lm_damping * mu
     }
