@@ -595,8 +595,7 @@ impl<'m> Solver<'m> {
 
     /// One QP step at the current configuration (errors from `stage_error`).
     fn step(&mut self, s: usize, targets: &[Pose], dt: f64) {
-        self.qp.h.fill(0.0);
-        self.qp.c.fill(0.0);
+        self.clear_objective();
         let mut mu_total = 0.0;
         for k in 0..self.stages[s].len() {
             mu_total += self.task_objective(s, k, targets);
@@ -613,6 +612,16 @@ impl<'m> Solver<'m> {
             }
         }
         self.take_step();
+    }
+
+    /// H and c to zero: H's upper triangle, all that the terms add to and the QP solvers and
+    /// the trajectory solve read (the lower one holds whatever the last solve left there).
+    fn clear_objective(&mut self) {
+        let nv = self.model.nv;
+        for d in 0..nv {
+            self.qp.h[d * nv + d..(d + 1) * nv].fill(0.0);
+        }
+        self.qp.c.fill(0.0);
     }
 
     /// Adds `diagonal` to H's diagonal.
