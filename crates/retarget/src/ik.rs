@@ -595,8 +595,7 @@ impl<'m> Solver<'m> {
 
     /// One QP step at the current configuration (errors from `stage_error`).
     fn step(&mut self, s: usize, targets: &[Pose], dt: f64) {
-        self.qp.h.fill(0.0);
-        self.qp.c.fill(0.0);
+        self.clear_objective();
         let mut mu_total = 0.0;
         for k in 0..self.stages[s].len() {
             mu_total += self.task_objective(s, k, targets);
@@ -615,22 +614,21 @@ impl<'m> Solver<'m> {
         self.take_step();
     }
 
+    /// H and c to zero: H's upper triangle, all that the terms add to and the QP solvers and
+    /// the trajectory solve read (the lower one holds whatever the last solve left there).
+    fn clear_objective(&mut self) {
+        let nv = self.model.nv;
+        for d in 0..nv {
+            self.qp.h[d * nv + d..(d + 1) * nv].fill(0.0);
+        }
+        self.qp.c.fill(0.0);
+    }
+
     /// Adds `diagonal` to H's diagonal.
     fn add_diagonal(&mut self, diagonal: f64) {
         let nv = self.model.nv;
         for d in 0..nv {
             self.qp.h[d * nv + d] += diagonal;
-        }
-    }
-
-    /// Mirrors H's upper triangle (where the terms are added) into the lower one, for the
-    /// box solver, which reads whole rows ([`DenseQp`] reads the upper triangle).
-    fn mirror_hessian(&mut self) {
-        let nv = self.model.nv;
-        for d in 0..nv {
-            for e in 0..d {
-                self.qp.h[d * nv + e] = self.qp.h[e * nv + d];
-            }
         }
     }
 
@@ -687,7 +685,7 @@ impl<'m> Solver<'m> {
             let col: [f64; 6] = std::array::from_fn(|r| task.wjac[r][a]);
             self.qp.c[da] -= dot6(&we, &col);
         }
-        // Upper triangle only (dofs ascending); mirrored for the box solver.
+        // Upper triangle only (dofs ascending), which is what both QP solvers read.
         task_terms::add_gram(&task.wjac, &w, &task.dofs, &task.runs, nv, &mut self.qp.h);
         self.options.lm_damping * mu
     }

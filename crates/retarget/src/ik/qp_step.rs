@@ -12,7 +12,6 @@ impl Solver<'_> {
     /// are held, else with them ([`Solver::constrained_step`]).
     pub(super) fn solve_step(&mut self) -> QpStatus {
         if self.constraints.is_empty() || !self.constraints_on {
-            self.mirror_hessian();
             let status = self.qp.solve();
             self.dq.copy_from_slice(&self.qp.x);
             status

@@ -92,8 +92,7 @@ impl<'m> Solver<'m> {
 
     /// The tasks of `stages` into H and c (from zero); returns their μ.
     fn fill_tasks(&mut self, stages: &[(usize, f64)], targets: &[Pose]) -> f64 {
-        self.qp.h.fill(0.0);
-        self.qp.c.fill(0.0);
+        self.clear_objective();
         let mut mu_total = 0.0;
         let count = self.stages.len();
         for &(s, factor) in stages.iter().filter(|&&(s, f)| s < count && f > 0.0) {

@@ -39,8 +39,9 @@ pub enum QpStatus {
     IterationLimit,
 }
 
-/// Problem data and workspace for one size `n`. Fill `h` (row-major `n × n`), `c`, `lb`,
-/// `ub`, call [`BoxQp::solve`], read `x`.
+/// Problem data and workspace for one size `n`. Fill `h` (row-major `n × n`, upper
+/// triangle: `h[i][j]` for `i ≤ j` is all that is read), `c`, `lb`, `ub`, call
+/// [`BoxQp::solve`], read `x`.
 #[derive(Debug, Clone)]
 pub struct BoxQp {
     n: usize,
@@ -60,9 +61,13 @@ pub struct BoxQp {
     /// variable its ancestors nearest first (the chains of `parent`).
     tree: bool,
     chains: Vec<Vec<usize>>,
-    /// The same chains as runs of consecutive indices `lo..=hi`, nearest first: the
-    /// factorisation's updates run along them over contiguous memory.
-    chain_runs: Vec<Vec<(usize, usize)>>,
+    /// Where variable `k`'s packed row starts in `packed`: `[H_kk, H_k,a₁, H_k,a₂, …]` over
+    /// its chain `a₁, a₂, …` (nearest first), `chains[k].len() + 1` entries. An ancestor's
+    /// row is the tail of its descendant's (its chain is the descendant's beyond it), so
+    /// every update of the factorisation is one contiguous `axpy` (MuJoCo's `M` layout).
+    row_adr: Vec<usize>,
+    /// The tree factor `L`, `D` of `H_FF = Lᵀ D L` in the packed layout.
+    packed: Vec<f64>,
     /// Number of active-set iterations of the last solve.
     pub iterations: usize,
 }
@@ -85,7 +90,8 @@ impl BoxQp {
             fixed: Vec::with_capacity(n),
             tree: false,
             chains: Vec::new(),
-            chain_runs: Vec::new(),
+            row_adr: Vec::new(),
+            packed: Vec::new(),
             iterations: 0,
         }
     }
@@ -105,7 +111,17 @@ impl BoxQp {
         } else {
             Vec::new()
         };
-        self.chain_runs = self.chains.iter().map(|chain| descending_runs(chain)).collect();
+        self.row_adr = self
+            .chains
+            .iter()
+            .scan(0, |adr, chain| {
+                let start = *adr;
+                *adr += chain.len() + 1;
+                Some(start)
+            })
+            .collect();
+        let len = self.chains.iter().map(|chain| chain.len() + 1).sum();
+        self.packed = vec![0.0; len];
         self.tree = ok;
     }
 
@@ -194,6 +210,13 @@ impl BoxQp {
         QpStatus::IterationLimit
     }
 
+    /// `H_ij` from the upper triangle, which is all that is read of `h`.
+    #[inline]
+    fn h_at(&self, i: usize, j: usize) -> f64 {
+        let (a, b) = if i <= j { (i, j) } else { (j, i) };
+        self.h[a * self.n + b]
+    }
+
     /// The bound variable whose multiplier is most negative (beyond rounding), if any.
     fn worst_multiplier(&self) -> Option<usize> {
         let n = self.n;
@@ -202,10 +225,10 @@ impl BoxQp {
             if self.state[i] == State::Free {
                 continue;
             }
-            let row = &self.h[i * n..(i + 1) * n];
             let mut g = self.c[i];
             let mut scale = self.c[i].abs();
-            for (hij, xj) in row.iter().zip(&self.x) {
+            for (j, xj) in self.x.iter().enumerate() {
+                let hij = self.h_at(i, j);
                 g += hij * xj;
                 scale += (hij * xj).abs();
             }
@@ -221,6 +244,11 @@ impl BoxQp {
     /// Minimiser over the free variables with the others fixed at `x`, written to `rhs`
     /// (free entries only). `false` if the reduced Hessian is not positive definite.
     fn solve_face(&mut self) -> bool {
+        let n = self.n;
+        self.free.clear();
+        self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
+        self.fixed.clear();
+        self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
         if self.tree {
             return self.solve_face_tree();
         }
@@ -229,10 +257,9 @@ impl BoxQp {
 
     /// Right-hand side `−c_F − H_FW x_W` of free variable `i` (`self.fixed`: the `W`).
     fn free_rhs(&self, i: usize) -> f64 {
-        let row = &self.h[i * self.n..(i + 1) * self.n];
         let mut r = -self.c[i];
         for &j in &self.fixed {
-            r -= row[j] * self.x[j];
+            r -= self.h_at(i, j) * self.x[j];
         }
         r
     }
@@ -241,17 +268,13 @@ impl BoxQp {
     /// Every variable free is the common case.
     fn solve_face_tree(&mut self) -> bool {
         let n = self.n;
-        self.free.clear();
-        self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
-        self.fixed.clear();
-        self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
-        // Only the entries the factorisation and the solves read: each row's diagonal and
-        // its chain (the rest of a row stays whatever it held).
-        for (k, runs) in self.chain_runs.iter().enumerate() {
-            let row = k * n;
-            self.chol[row + k] = self.h[row + k];
-            for &(lo, hi) in runs {
-                self.chol[row + lo..=row + hi].copy_from_slice(&self.h[row + lo..=row + hi]);
+        // H's tree entries into the packed rows (from the upper triangle: an ancestor has
+        // the lower index).
+        for (k, chain) in self.chains.iter().enumerate() {
+            let row = &mut self.packed[self.row_adr[k]..][..=chain.len()];
+            row[0] = self.h[k * n + k];
+            for (entry, &a) in row[1..].iter_mut().zip(chain) {
+                *entry = self.h[a * n + k];
             }
         }
         for i in 0..n {
@@ -268,35 +291,34 @@ impl BoxQp {
         true
     }
 
-    /// `L` and `D` of `H_FF = Lᵀ D L`, leaves first (`mj_factorI`), in place in `chol`.
+    /// `L` and `D` of `H_FF = Lᵀ D L`, leaves first (`mj_factorI`), in place in `packed`.
     /// Eliminating `k` subtracts `l_ki l_kj / d_k` from `(i, j)` for the free ancestors
-    /// `j ≤ i` of `k`: each entry once, so the updates run in any order, here along runs of
-    /// the chain. Entries in a fixed variable's column are updated too but never read for a
-    /// free one.
+    /// `i` of `k` and `j` of `i` (or `i` itself): row `i`'s packed entries at once, from
+    /// the tail of row `k`'s. Entries in a fixed variable's column are updated too but never
+    /// read for a free one.
     fn factor_tree(&mut self) -> bool {
-        let n = self.n;
-        let l = &mut self.chol;
-        for k in (0..n).rev() {
-            if self.state[k] != State::Free {
+        let all_free = self.fixed.is_empty();
+        for k in (0..self.n).rev() {
+            if !all_free && self.state[k] != State::Free {
                 continue;
             }
-            let (above, rest) = l.split_at_mut(k * n);
-            let row_k = &mut rest[..n];
-            let dk = row_k[k];
+            let adr = self.row_adr[k];
+            let chain = &self.chains[k];
+            let (above, rest) = self.packed.split_at_mut(adr);
+            let row_k = &mut rest[..=chain.len()];
+            let dk = row_k[0];
             if dk.is_nan() || dk <= 0.0 || !dk.is_finite() {
                 return false;
             }
-            let runs = &self.chain_runs[k];
-            for (r, &(lo, hi)) in runs.iter().enumerate() {
-                for ii in (lo..=hi).rev().filter(|&i| self.state[i] == State::Free) {
-                    let tmp = row_k[ii] / dk;
-                    let row_ii = &mut above[ii * n..(ii + 1) * n];
-                    subtract_scaled(&mut row_ii[lo..=ii], tmp, &row_k[lo..=ii]);
-                    for &(lo, hi) in &runs[r + 1..] {
-                        subtract_scaled(&mut row_ii[lo..=hi], tmp, &row_k[lo..=hi]);
-                    }
-                    row_k[ii] = tmp;
+            for (p, &i) in chain.iter().enumerate() {
+                if !all_free && self.state[i] != State::Free {
+                    continue;
                 }
+                let tail = &row_k[p + 1..];
+                let tmp = tail[0] / dk;
+                let row_i = &mut above[self.row_adr[i]..][..tail.len()];
+                subtract_scaled(row_i, tmp, tail);
+                row_k[p + 1] = tmp;
             }
         }
         true
@@ -305,23 +327,24 @@ impl BoxQp {
     /// `L⁻¹`, `D⁻¹`, `L⁻ᵀ` on `y` (`mj_solveM`), the free entries into `rhs`. The fixed
     /// entries of `y` take updates that no free one reads.
     fn solve_tree(&mut self) {
-        let n = self.n;
-        let (l, y) = (&self.chol, &mut self.y);
+        let all_free = self.fixed.is_empty();
+        let (l, y) = (&self.packed, &mut self.y);
         for &k in self.free.iter().rev() {
-            let (yk, row_k) = (y[k], &l[k * n..(k + 1) * n]);
-            for &(lo, hi) in &self.chain_runs[k] {
-                subtract_scaled(&mut y[lo..=hi], yk, &row_k[lo..=hi]);
+            let yk = y[k];
+            let row_k = &l[self.row_adr[k] + 1..][..self.chains[k].len()];
+            for (&i, &lki) in self.chains[k].iter().zip(row_k) {
+                y[i] -= yk * lki;
             }
         }
         for &k in &self.free {
-            y[k] /= l[k * n + k];
+            y[k] /= l[self.row_adr[k]];
         }
         for &k in &self.free {
-            let row_k = &l[k * n..(k + 1) * n];
+            let row_k = &l[self.row_adr[k] + 1..][..self.chains[k].len()];
             let mut yk = y[k];
-            for &ii in &self.chains[k] {
-                if self.state[ii] == State::Free {
-                    yk -= row_k[ii] * y[ii];
+            for (&i, &lki) in self.chains[k].iter().zip(row_k) {
+                if all_free || self.state[i] == State::Free {
+                    yk -= lki * y[i];
                 }
             }
             y[k] = yk;
@@ -330,25 +353,12 @@ impl BoxQp {
     }
 
     fn solve_face_dense(&mut self) -> bool {
-        let n = self.n;
-        self.free.clear();
-        self.free.extend((0..n).filter(|&i| self.state[i] == State::Free));
-        self.fixed.clear();
-        self.fixed.extend((0..n).filter(|&i| self.state[i] != State::Free));
         let m = self.free.len();
-        if m == n {
-            self.chol.copy_from_slice(&self.h);
-            for (y, c) in self.y.iter_mut().zip(&self.c) {
-                *y = -c;
-            }
-        } else {
-            for a in 0..m {
-                let i = self.free[a];
-                self.y[a] = self.free_rhs(i);
-                let row = &self.h[i * n..(i + 1) * n];
-                for (b, &j) in self.free.iter().enumerate() {
-                    self.chol[a * m + b] = row[j];
-                }
+        for a in 0..m {
+            let i = self.free[a];
+            self.y[a] = if m == self.n { -self.c[i] } else { self.free_rhs(i) };
+            for b in 0..=a {
+                self.chol[a * m + b] = self.h_at(i, self.free[b]);
             }
         }
         let l = &mut self.chol[..m * m];
@@ -375,25 +385,12 @@ impl BoxQp {
         true
     }
 }
-
 /// `x ← x − t y` elementwise.
 #[inline]
 fn subtract_scaled(x: &mut [f64], t: f64, y: &[f64]) {
     for (x, y) in x.iter_mut().zip(y) {
         *x -= t * y;
     }
-}
-
-/// `chain` (strictly descending) as runs `(lo, hi)` of consecutive indices, in its order.
-fn descending_runs(chain: &[usize]) -> Vec<(usize, usize)> {
-    let mut runs: Vec<(usize, usize)> = Vec::new();
-    for &i in chain {
-        match runs.last_mut() {
-            Some(run) if run.0 == i + 1 => run.0 = i,
-            _ => runs.push((i, i)),
-        }
-    }
-    runs
 }
 
 /// Lower Cholesky factor `L` (row-major, lower triangle) of the `m × m` matrix in `a`.

@@ -43,11 +43,13 @@ pub fn percentile(x: &[f64], p: f64) -> f64 {
         return 0.0;
     }
     let mut s = x.to_vec();
-    s.sort_by(f64::total_cmp);
     let pos = p * (s.len() - 1) as f64;
     let (i, frac) = (pos.floor() as usize, pos - pos.floor());
-    let next = s[(i + 1).min(s.len() - 1)];
-    s[i] + (next - s[i]) * frac
+    // The two order statistics `i` and `i + 1` (by `total_cmp`, as a sort would place
+    // them) without sorting: a selection, then the least of what lies above it.
+    let (_, &mut at, above) = s.select_nth_unstable_by(i, f64::total_cmp);
+    let next = above.iter().copied().min_by(f64::total_cmp).unwrap_or(at);
+    at + (next - at) * frac
 }
 
 pub(super) fn stats(x: &[f64]) -> Stats {
