@@ -13,6 +13,7 @@ use std::ops::Range;
 
 use mjcf::Model;
 
+use super::first_pass::first_pass_frame;
 use super::pipeline::ReweighOptions;
 use super::prepare::{Problem, Tasks};
 use super::{StageReport, StageValue};
@@ -78,7 +79,7 @@ fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
     let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
     for window in windows {
         for f in window.clone() {
-            problem.first_pass_frame(&mut solver, f, f == window.start)?;
+            first_pass_frame(problem, &mut solver, f, f == window.start)?;
             if f >= window.start + settle || window.len() <= settle {
                 let target = &problem.frame_targets(f)[root_target];
                 heights.push(solver.data().xpos[body].z - target.pos.z);

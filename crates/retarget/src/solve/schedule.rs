@@ -18,6 +18,7 @@ use std::ops::Range;
 use mjcf::Model;
 use rayon::prelude::*;
 
+use super::first_pass::first_pass;
 use super::prepare::{Problem, Solved};
 use super::ChunkOptions;
 use crate::Error;
@@ -37,7 +38,7 @@ pub(super) fn solve_range(
     let end = (range.end + ahead).min(problem.num_frames());
     let mut solver = problem.solver()?;
     // 5. The first pass.
-    let (mut qpos, mut frames) = problem.first_pass(&mut solver, first..end)?;
+    let Solved { mut qpos, mut frames } = first_pass(problem, &mut solver, first..end)?;
     // 6. The trajectory solve.
     if let (Some(options), false) = (trajectory, qpos.is_empty()) {
         problem.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
