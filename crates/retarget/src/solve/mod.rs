@@ -152,10 +152,7 @@ pub(crate) fn solve_clip(
     let (targets, plan) = footholds::plan(&clip, &stages, contacts.as_ref(), targets);
     let problem = Problem { clip, stages, targets, contacts, plan };
     // 4. Reweighing: the tasks, where the config's pelvis disagrees with the robot's legs.
-    let (problem, reweighed) = match reweigh::reweigh_where_planted(&problem)? {
-        Some((stages, report)) => (Problem { stages, ..problem }, Some(report)),
-        None => (problem, None),
-    };
+    let (problem, reweighed) = reweigh::reweigh_where_planted(problem)?;
     // What the stages that ran have to say, in order.
     let reports = walked.as_ref().map(|(_, report)| report.clone()).into_iter().chain(reweighed);
     let start = Instant::now();
