@@ -1,7 +1,7 @@
-//! Stage 5, the first pass: every frame solved causally (GMR's tasks and stage loop with the
-//! hard constraints, warm-started from the frame before; the first frame from the better of
-//! two starts), optionally also backwards and spliced. What streams run; the trajectory
-//! solve's initial trajectory.
+//! Stage 5, the first pass ([`first_pass`]): every frame solved causally (GMR's tasks and
+//! stage loop with the hard constraints, warm-started from the frame before; the first frame
+//! from the better of two starts), optionally also backwards and spliced. What streams run;
+//! the trajectory solve's initial trajectory.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in

@@ -28,13 +28,16 @@
 //!       ─2 contacts────► the source's contact phases
 //!       ─3 plan────────► the targets with the feet's planted, the foot plan
 //!                        → Problem { clip, tasks, targets, contacts, plan }
-//!       ─4 reweigh─────► the tasks reweighed and its report → the Problem with those tasks
-//!       ─5, 6 schedule─► qpos and each frame's diagnostics, from `&Problem`
+//!       ─4 reweigh─────► the Problem with its tasks reweighed (measured by stage 5's
+//!                        `first_pass_frame` on the Problem it was given), its report
+//!       ─5, 6 schedule─► per range: first_pass(&Problem, solver) → Solved,
+//!                        solve_trajectory(&Problem, solver, Solved) → Solved
 //!       → RobotMotion and ClipDiagnostics (`Problem::finish`, with the stages' reports)
 //! ```
 //!
 //! The solving stages (5 and 6: `first_pass.rs`, `windows.rs`, and the per-frame foot tasks
-//! in `footholds.rs`) read the `Problem` and change nothing in it.
+//! in `footholds.rs`) are functions of `&Problem` and change nothing in it; stage 4 is the
+//! one stage that takes a `Problem` and returns another.
 
 pub(crate) mod banded;
 mod contacts;

@@ -1,4 +1,5 @@
-//! Stage 6's schedule: a clip's trajectory solve window after window ([`super::trajectory`]).
+//! Stage 6's windows ([`solve_trajectory`]): a range's trajectory solve
+//! ([`super::trajectory`]) window after window, from its first pass.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in
