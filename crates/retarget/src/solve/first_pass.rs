@@ -1,7 +1,7 @@
-//! Stage 5, the first pass: every frame solved causally (GMR's tasks and stage loop with the
-//! hard constraints, warm-started from the frame before; the first frame from the better of
-//! two starts), optionally also backwards and spliced. What streams run; the trajectory
-//! solve's initial trajectory.
+//! Stage 5, the first pass ([`first_pass`]): every frame solved causally (GMR's tasks and
+//! stage loop with the hard constraints, warm-started from the frame before; the first frame
+//! from the better of two starts), optionally also backwards and spliced. What streams run;
+//! the trajectory solve's initial trajectory.
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frames and slots index the clip's own target buffer (`frames × slots`, built in
@@ -15,85 +15,88 @@ use mjcf::{JointType, Model};
 use nalgebra::Vector3;
 
 use super::prepare::reject_divergence;
-use super::prepare::Problem;
+use super::prepare::{Problem, Solved};
 use crate::ik::{FrameDiagnostics, Solver};
 use crate::lie::Pose;
 use crate::Error;
 
-impl<'a> Problem<'a> {
-    /// The first pass over frames `frames` (forward; with [`crate::PlausibleOptions::both_ways`]
-    /// also backward, on a second thread of rayon's pool, and spliced).
-    pub(super) fn first_pass(
-        &self,
-        solver: &mut Solver<'a>,
-        frames: Range<usize>,
-    ) -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
-        let nq = self.clip.model.nq;
-        let (first, end) = (frames.start, frames.end);
-        // Every constraint holds from the first pass on. (A first pass under box bounds only
-        // is 1.4× faster on the G1, but on robots whose tracking drives links into each
-        // other, e.g. Toddy's hips, the next step cannot get out within the speed limits.)
-        let forward =
-            |solver: &mut Solver<'_>| -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
-                let mut qpos = Vec::with_capacity((end - first) * nq);
-                let mut out = Vec::with_capacity(end - first);
-                for f in first..end {
-                    out.push(self.first_pass_frame(solver, f, f == first)?);
-                    reject_divergence(solver.qpos(), f)?;
-                    qpos.extend_from_slice(solver.qpos());
-                }
-                Ok((qpos, out))
-            };
-        if !self.clip.pipeline.both_ways {
-            return forward(solver);
-        }
-        // The two directions on two threads of rayon's pool (one, in a busy pool, is the same
-        // work in turn).
-        let (ahead, back) =
-            rayon::join(|| forward(solver), || self.first_pass_backward(first..end));
-        let ((mut qpos, mut out), (back, back_frames)) = (ahead?, back?);
-        let (coords, quats) = compared_coordinates(self.clip.model);
-        splice_passes(nq, (&coords, &quats), &mut qpos, &mut out, &back, &back_frames);
-        Ok((qpos, out))
-    }
-
-    /// Frame `f` of a first pass: its foot tasks set, solved from the previous frame's pose
-    /// (the `first` of a solve: from [`solve_first_frame`]'s start in the default mode, and
-    /// without speed limits).
-    pub(super) fn first_pass_frame(
-        &self,
-        solver: &mut Solver<'_>,
-        f: usize,
-        first: bool,
-    ) -> Result<FrameDiagnostics, Error> {
-        self.set_frame_tasks(solver, f)?;
-        let targets = self.frame_targets(f);
-        let diagnostics = if first && !self.clip.pipeline.is_gmr() {
-            solve_first_frame(self.clip.model, solver, &self.clip.tracked, targets)?
-        } else {
-            solver.solve_frame(targets, first_frame_dt(first, self.clip.frame_dt()))?
-        };
-        Ok(diagnostics)
-    }
-
-    /// The first pass run backwards over `range`: from its last frame (solved as a first
-    /// frame) to its first, each frame warm-started from the one after it.
-    fn first_pass_backward(
-        &self,
-        range: Range<usize>,
-    ) -> Result<(Vec<f64>, Vec<FrameDiagnostics>), Error> {
-        let mut solver = self.solver()?;
-        let nq = self.clip.model.nq;
-        let mut qpos = vec![0.0; range.len() * nq];
-        let mut frames = vec![FrameDiagnostics::default(); range.len()];
-        for (k, f) in range.clone().enumerate().rev() {
-            frames[k] = self.first_pass_frame(&mut solver, f, f + 1 == range.end)?;
-            frames[k].backward = true;
+/// Stage 5 over frames `frames` of `problem` with `solver` (forward; with
+/// [`crate::PlausibleOptions::both_ways`] also backward, on a second thread of rayon's pool
+/// with a solver of its own, and spliced): each frame's `qpos` and diagnostics.
+pub(super) fn first_pass<'a>(
+    problem: &Problem<'a>,
+    solver: &mut Solver<'a>,
+    frames: Range<usize>,
+) -> Result<Solved, Error> {
+    let nq = problem.clip.model.nq;
+    let (first, end) = (frames.start, frames.end);
+    // Every constraint holds from the first pass on. (A first pass under box bounds only
+    // is 1.4× faster on the G1, but on robots whose tracking drives links into each
+    // other, e.g. Toddy's hips, the next step cannot get out within the speed limits.)
+    let forward = |solver: &mut Solver<'_>| -> Result<Solved, Error> {
+        let mut qpos = Vec::with_capacity((end - first) * nq);
+        let mut out = Vec::with_capacity(end - first);
+        for f in first..end {
+            out.push(first_pass_frame(problem, solver, f, f == first)?);
             reject_divergence(solver.qpos(), f)?;
-            qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
+            qpos.extend_from_slice(solver.qpos());
         }
-        Ok((qpos, frames))
+        Ok(Solved { qpos, frames: out })
+    };
+    if !problem.clip.pipeline.both_ways {
+        return forward(solver);
     }
+    // The two directions on two threads of rayon's pool (one, in a busy pool, is the same
+    // work in turn).
+    let (ahead, back) =
+        rayon::join(|| forward(solver), || first_pass_backward(problem, first..end));
+    let (mut ahead, back) = (ahead?, back?);
+    let (coords, quats) = compared_coordinates(problem.clip.model);
+    splice_passes(
+        nq,
+        (&coords, &quats),
+        &mut ahead.qpos,
+        &mut ahead.frames,
+        &back.qpos,
+        &back.frames,
+    );
+    Ok(ahead)
+}
+
+/// Frame `f` of a first pass over `problem`: its foot tasks set, solved from the previous
+/// frame's pose (the `first` of a solve: from [`solve_first_frame`]'s start in the default
+/// mode, and without speed limits). Stage 4 measures the pelvis with it.
+pub(super) fn first_pass_frame(
+    problem: &Problem<'_>,
+    solver: &mut Solver<'_>,
+    f: usize,
+    first: bool,
+) -> Result<FrameDiagnostics, Error> {
+    problem.set_frame_tasks(solver, f)?;
+    let clip = &problem.clip;
+    let targets = problem.frame_targets(f);
+    let diagnostics = if first && !clip.pipeline.is_gmr() {
+        solve_first_frame(clip.model, solver, &clip.tracked, targets)?
+    } else {
+        solver.solve_frame(targets, first_frame_dt(first, clip.frame_dt()))?
+    };
+    Ok(diagnostics)
+}
+
+/// The first pass run backwards over `range`: from its last frame (solved as a first
+/// frame) to its first, each frame warm-started from the one after it.
+fn first_pass_backward(problem: &Problem<'_>, range: Range<usize>) -> Result<Solved, Error> {
+    let mut solver = problem.solver()?;
+    let nq = problem.clip.model.nq;
+    let mut qpos = vec![0.0; range.len() * nq];
+    let mut frames = vec![FrameDiagnostics::default(); range.len()];
+    for (k, f) in range.clone().enumerate().rev() {
+        frames[k] = first_pass_frame(problem, &mut solver, f, f + 1 == range.end)?;
+        frames[k].backward = true;
+        reject_divergence(solver.qpos(), f)?;
+        qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());
+    }
+    Ok(Solved { qpos, frames })
 }
 
 /// The `dt` a solve's first frame is solved with: 0, so that no joint speed limit holds

@@ -28,13 +28,16 @@
 //!       ─2 contacts────► the source's contact phases
 //!       ─3 plan────────► the targets with the feet's planted, the foot plan
 //!                        → Problem { clip, tasks, targets, contacts, plan }
-//!       ─4 reweigh─────► the tasks reweighed and its report → the Problem with those tasks
-//!       ─5, 6 schedule─► qpos and each frame's diagnostics, from `&Problem`
+//!       ─4 reweigh─────► the Problem with its tasks reweighed (measured by stage 5's
+//!                        `first_pass_frame` on the Problem it was given), its report
+//!       ─5, 6 schedule─► per range: first_pass(&Problem, solver) → Solved,
+//!                        solve_trajectory(&Problem, solver, Solved) → Solved
 //!       → RobotMotion and ClipDiagnostics (`Problem::finish`, with the stages' reports)
 //! ```
 //!
 //! The solving stages (5 and 6: `first_pass.rs`, `windows.rs`, and the per-frame foot tasks
-//! in `footholds.rs`) read the `Problem` and change nothing in it.
+//! in `footholds.rs`) are functions of `&Problem` and change nothing in it; stage 4 is the
+//! one stage that takes a `Problem` and returns another.
 
 pub(crate) mod banded;
 mod contacts;
@@ -152,10 +155,7 @@ pub(crate) fn solve_clip(
     let (targets, plan) = footholds::plan(&clip, &stages, contacts.as_ref(), targets);
     let problem = Problem { clip, stages, targets, contacts, plan };
     // 4. Reweighing: the tasks, where the config's pelvis disagrees with the robot's legs.
-    let (problem, reweighed) = match reweigh::reweigh_where_planted(&problem)? {
-        Some((stages, report)) => (Problem { stages, ..problem }, Some(report)),
-        None => (problem, None),
-    };
+    let (problem, reweighed) = reweigh::reweigh_where_planted(problem)?;
     // What the stages that ran have to say, in order.
     let reports = walked.as_ref().map(|(_, report)| report.clone()).into_iter().chain(reweighed);
     let start = Instant::now();

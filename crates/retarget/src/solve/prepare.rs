@@ -49,8 +49,8 @@ pub(crate) type PlannedFeet = ([Option<RobotFoot>; 2], FootPlan);
 
 /// What the solving stages (5 and 6, over [`super::schedule`]) solve: the [`Clip`], the
 /// tasks, every frame's targets (foot-planned in the default mode), the source's contacts and
-/// the foot plan. The driver builds it from the earlier stages' outputs (stage 4's tasks in
-/// place of the config's where it reweighs them); the solving stages only read it. Solving
+/// the foot plan. The driver builds it from the outputs of stages 1 to 3; stage 4 returns it
+/// with its tasks reweighed where it reweighs them; the solving stages only read it. Solving
 /// frame ranges of it independently is how [`super::schedule`] parallelises a clip.
 pub(crate) struct Problem<'a> {
     pub(super) clip: Clip<'a>,
@@ -65,7 +65,8 @@ pub(crate) struct Problem<'a> {
     pub(super) plan: Option<PlannedFeet>,
 }
 
-/// Solved frames of a range.
+/// Solved frames of a range: each frame's `qpos` (`nq` numbers a frame) and diagnostics,
+/// what stages 5 and 6 return.
 pub(crate) struct Solved {
     pub qpos: Vec<f64>,
     pub frames: Vec<FrameDiagnostics>,

@@ -13,19 +13,31 @@ use std::ops::Range;
 
 use mjcf::Model;
 
+use super::first_pass::first_pass_frame;
 use super::pipeline::ReweighOptions;
 use super::prepare::{Problem, Tasks};
 use super::{StageReport, StageValue};
 use crate::ik::TaskSpec;
 use crate::Error;
 
-/// Stage 4 (default solve, feet planted): `problem`'s tasks [`reweigh`]ed by how far the
-/// robot's pelvis stands from its target with them ([`pelvis_offset`],
-/// [`crate::PlausibleOptions::pelvis_offset_range`]), and what was done; `None` where the
-/// stage does not run, or the config does not pin the pelvis (the tasks stay the config's).
+/// Stage 4 (default solve, feet planted): the `problem` of stages 1 to 3 with its tasks
+/// [`reweigh`]ed by how far the robot's pelvis stands from its target with the config's
+/// ([`pelvis_offset`]: stage 5's [`first_pass_frame`] over a few windows of that problem),
+/// and what was done. Where the stage does not run, or the config does not pin the pelvis,
+/// the problem comes back as it was, with no report.
 pub(super) fn reweigh_where_planted(
-    problem: &Problem<'_>,
-) -> Result<Option<(Tasks, StageReport)>, Error> {
+    problem: Problem<'_>,
+) -> Result<(Problem<'_>, Option<StageReport>), Error> {
+    Ok(match reweighed_tasks(&problem)? {
+        Some((stages, report)) => (Problem { stages, ..problem }, Some(report)),
+        None => (problem, None),
+    })
+}
+
+/// [`reweigh_where_planted`]'s tasks and report, the share of the change set by where the
+/// offset falls in [`crate::PlausibleOptions::pelvis_offset_range`]; `None` where the tasks
+/// stay the config's.
+fn reweighed_tasks(problem: &Problem<'_>) -> Result<Option<(Tasks, StageReport)>, Error> {
     let Some(options) = problem.clip.pipeline.reweigh else { return Ok(None) };
     if problem.plan.is_none() {
         return Ok(None);
@@ -78,7 +90,7 @@ fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
     let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
     for window in windows {
         for f in window.clone() {
-            problem.first_pass_frame(&mut solver, f, f == window.start)?;
+            first_pass_frame(problem, &mut solver, f, f == window.start)?;
             if f >= window.start + settle || window.len() <= settle {
                 let target = &problem.frame_targets(f)[root_target];
                 heights.push(solver.data().xpos[body].z - target.pos.z);

@@ -18,7 +18,9 @@ use std::ops::Range;
 use mjcf::Model;
 use rayon::prelude::*;
 
+use super::first_pass::first_pass;
 use super::prepare::{Problem, Solved};
+use super::windows::solve_trajectory;
 use super::ChunkOptions;
 use crate::Error;
 
@@ -37,11 +39,12 @@ pub(super) fn solve_range(
     let end = (range.end + ahead).min(problem.num_frames());
     let mut solver = problem.solver()?;
     // 5. The first pass.
-    let (mut qpos, mut frames) = problem.first_pass(&mut solver, first..end)?;
+    let mut solved = first_pass(problem, &mut solver, first..end)?;
     // 6. The trajectory solve.
-    if let (Some(options), false) = (trajectory, qpos.is_empty()) {
-        problem.solve_trajectory(&mut solver, options, first, &mut qpos, &mut frames)?;
+    if let (Some(options), false) = (trajectory, solved.qpos.is_empty()) {
+        solved = solve_trajectory(problem, &mut solver, options, first, solved)?;
     }
+    let Solved { mut qpos, mut frames } = solved;
     let skip = range.start - first;
     qpos.truncate((range.end - first) * nq);
     frames.truncate(range.end - first);
