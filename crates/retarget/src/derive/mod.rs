@@ -486,9 +486,10 @@ const CARRYING: [Part; 7] =
 pub const CONTRADICTS: f64 = std::f64::consts::FRAC_PI_2;
 
 /// Where the `tuned` config contradicts the robot's joint frames (as the `derived` config
-/// for the same source has them): its row for a body that carries the robot (pelvis, trunk, legs) whose rotation
-/// offset is more than [`CONTRADICTS`] from the derived one's (same robot and human body,
-/// both with a rotation weight), the furthest, as `(robot body, angle in rad)`.
+/// for the same source has them): its row for a body that carries the robot (pelvis, trunk,
+/// legs) whose rotation offset is more than [`CONTRADICTS`] from the derived one's (same
+/// robot and human body, both with a rotation weight), the furthest, as `(robot body, angle
+/// in rad)`.
 #[must_use]
 pub fn contradiction(
     tuned: &IkConfig,
