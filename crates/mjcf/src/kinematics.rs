@@ -302,6 +302,26 @@ impl Model {
         }
     }
 
+    /// Column `d` of [`Model::jac_chain`]'s `jacp` and `jacr` for a body at `point` (its
+    /// `xpos`) whose path to the world has dof `d`: the same numbers, for callers that
+    /// transform each column as it comes instead of gathering it from a strided `3 × nv`
+    /// buffer. `None` for a dof `data` does not hold.
+    #[must_use]
+    #[inline]
+    pub fn jac_column(
+        data: &Data,
+        point: &Vector3<f64>,
+        d: usize,
+    ) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let (axis, linear, anchor) =
+            (data.dof_axis.get(d)?, data.dof_linear.get(d)?, data.dof_anchor.get(d)?);
+        Some(if *linear {
+            (*axis, Vector3::zeros())
+        } else {
+            (axis.cross(&(point - anchor)), *axis)
+        })
+    }
+
     /// The columns of [`Model::jac`]'s `jacp` at `point` moving with `body` that can be
     /// non-zero: `(dof, column)` for each dof on the body's path to the world, from the body
     /// towards the world ([`Model::body_dofs`]), the same numbers as `jac` writes. For callers

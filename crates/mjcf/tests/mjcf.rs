@@ -245,6 +245,26 @@ fn jac_point_columns_are_the_columns_of_jac() {
     assert_eq!(model.jac_point_columns(&other, 1, Vector3::zeros()).count(), 0);
 }
 
+/// `jac_column` is `jac_chain`'s column of every dof on a body's path, bit for bit.
+#[test]
+fn jac_column_is_the_column_of_jac_chain() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/features/features.xml");
+    let model = Model::from_file(&path).unwrap();
+    let mut data = Data::new(&model);
+    model.kinematics(&model.random_qpos(&mut ChaCha8Rng::seed_from_u64(5)), &mut data);
+    let nv = model.nv;
+    let (mut jp, mut jr) = (vec![0.0; 3 * nv], vec![0.0; 3 * nv]);
+    for b in 0..model.bodies.len() {
+        model.jac_chain(&data, b, &mut jp, &mut jr);
+        for d in model.body_dofs(b) {
+            let column = |j: &[f64]| Vector3::new(j[d], j[nv + d], j[2 * nv + d]);
+            let got = Model::jac_column(&data, &data.xpos[b], d);
+            assert_eq!(got, Some((column(&jp), column(&jr))), "body {b} dof {d}");
+        }
+    }
+    assert_eq!(Model::jac_column(&data, &Vector3::zeros(), nv), None);
+}
+
 #[test]
 fn integrate_pos_follows_mujoco() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/features/features.xml");

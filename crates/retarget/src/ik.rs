@@ -666,11 +666,11 @@ impl<'m> Solver<'m> {
             }
             Arithmetic::Lean => lie::se3_jlog_at(&task.err),
         };
-        self.model.jac_chain(&self.data, body, &mut self.jacp, &mut self.jacr);
         let xmat = self.data.xmat[body];
         let task = &mut self.stages[s][k];
         let w: [f64; 6] = std::array::from_fn(|r| task.cost[r] * task.scale[r]);
-        let jac = (&self.jacp[..], &self.jacr[..], nv);
+        // The body's Jacobian column by column as the rows take it (`jac_chain`'s numbers).
+        let jac = (&self.data, &self.data.xpos[body]);
         match self.options.arithmetic {
             Arithmetic::Mink => {
                 task_terms::mink_rows(&jlog, &xmat, &w, jac, &task.dofs, &mut task.wjac)

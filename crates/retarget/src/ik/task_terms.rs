@@ -8,7 +8,8 @@
 // weighted rows are `dofs.len()` long (`TaskWork::new`); runs lie inside `dofs`.
 #![allow(clippy::indexing_slicing)]
 
-use nalgebra::{Matrix3, Matrix6};
+use mjcf::{Data, Model};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
 /// A task's weighted Jacobian, one row per task coordinate (position x y z, rotation x y
 /// z), one entry per dof of `dofs` (rows apart, so that the Gram products below run along
@@ -28,10 +29,12 @@ pub(super) fn runs(dofs: &[usize]) -> Vec<(usize, usize)> {
     runs
 }
 
-/// The 6 Jacobian entries of dof `d` from `mj_jac`'s `3 × nv` row-major blocks.
+/// The 6 Jacobian entries of dof `d` of the body at `point`, as `mj_jac` writes them
+/// ([`mjcf::Model::jac_column`]; zeros for a dof `data` does not hold).
 #[inline]
-fn column(jacp: &[f64], jacr: &[f64], nv: usize, d: usize) -> ([f64; 3], [f64; 3]) {
-    ([jacp[d], jacp[nv + d], jacp[2 * nv + d]], [jacr[d], jacr[nv + d], jacr[2 * nv + d]])
+fn column(data: &Data, point: &Vector3<f64>, d: usize) -> ([f64; 3], [f64; 3]) {
+    let (jp, jr) = Model::jac_column(data, point, d).unwrap_or_default();
+    (jp.into(), jr.into())
 }
 
 /// `m v` with nalgebra's order of operations (column by column: `Σₖ m[r, k] v[k]` from
@@ -49,14 +52,14 @@ pub(super) fn mink_rows(
     jlog: &Matrix6<f64>,
     xmat: &Matrix3<f64>,
     w: &[f64; 6],
-    (jacp, jacr, nv): (&[f64], &[f64], usize),
+    (data, point): (&Data, &Vector3<f64>),
     dofs: &[usize],
     rows: &mut Rows,
 ) {
     let rt = xmat.transpose();
     let j = |r: usize, c: usize| jlog[(r, c)];
     for (i, &d) in dofs.iter().enumerate() {
-        let (jp, jr) = column(jacp, jacr, nv, d);
+        let (jp, jr) = column(data, point, d);
         let bp = mat3_vec(&rt, &jp);
         if jr == [0.0; 3] {
             // A translation: `Rᵀ jr` and every product with it are zeros.
@@ -88,7 +91,7 @@ pub(super) fn lean_rows(
     jlog: &Matrix6<f64>,
     xmat: &Matrix3<f64>,
     w: &[f64; 6],
-    (jacp, jacr, nv): (&[f64], &[f64], usize),
+    (data, point): (&Data, &Vector3<f64>),
     dofs: &[usize],
     rows: &mut Rows,
 ) {
@@ -96,7 +99,7 @@ pub(super) fn lean_rows(
     let a = jlog.fixed_view::<3, 3>(0, 0) * rt;
     let b = jlog.fixed_view::<3, 3>(0, 3) * rt;
     for (i, &d) in dofs.iter().enumerate() {
-        let (jp, jr) = column(jacp, jacr, nv, d);
+        let (jp, jr) = column(data, point, d);
         let top_a = mat3_vec(&a, &jp);
         if jr == [0.0; 3] {
             // A translation: the products with `jr` are zeros.
