@@ -53,25 +53,23 @@ pub fn choose(
         let summary = format!("config {} (role-named), bound to the body model", config.source);
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }
+    let tuned = tuned.filter(|t| t.validate(model, names).is_ok());
+    let take = |tuned: &IkConfig| {
+        let summary = format!("config {} (tuned: SMPL joint names and frames)", tuned.source);
+        Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary })
+    };
+    // `--gmr` takes GMR's config as GMR does.
+    if let (Some(tuned), true) = (tuned, gmr) {
+        return take(tuned);
+    }
     let roles = RobotRoles::recognise(model)?;
     let source = format!("<derived for {robot}>");
     let derived = crate::derive::derive(model, &roles, &human_body(clip)?, &source)?;
     let mut why_not = String::new();
-    if let Some(tuned) = tuned.filter(|t| t.validate(model, names).is_ok()) {
-        // (`--gmr` takes GMR's config as GMR does.)
-        match crate::derive::contradiction(tuned, &derived, &roles).filter(|_| !gmr) {
-            None => {
-                let summary =
-                    format!("config {} (tuned: SMPL joint names and frames)", tuned.source);
-                return Ok(Chosen { config: tuned.clone(), choice: Choice::Tuned, summary });
-            }
-            Some((body, angle)) => {
-                why_not = format!(
-                    " (not the tuned {}: it turns {body} {:.0}° from the robot's joint frames)",
-                    tuned.source,
-                    angle.to_degrees()
-                );
-            }
+    if let Some(tuned) = tuned {
+        match crate::derive::contradiction(tuned, &derived, &roles) {
+            None => return take(tuned),
+            Some(c) => why_not = format!(" (not the tuned {}: {c})", tuned.source),
         }
     }
     let summary =

@@ -408,9 +408,9 @@ fn a_tuned_config_that_turns_a_knee_over_contradicts_the_robot() {
         entry.rot_offset *= turn;
         config
     };
-    let (body, angle) = derive::contradiction(&turned(&knee, 3.0), &derived, &roles).unwrap();
-    assert_eq!(body, knee);
-    assert!((angle - 3.0).abs() < 1e-9, "{angle}");
+    let found = derive::contradiction(&turned(&knee, 3.0), &derived, &roles).unwrap();
+    assert_eq!(found.body, knee);
+    assert!((found.angle - 3.0).abs() < 1e-9, "{}", found.angle);
     assert_eq!(derive::contradiction(&turned(&knee, 1.4), &derived, &roles), None);
     assert_eq!(derive::contradiction(&turned(&hand, 3.0), &derived, &roles), None);
 }

@@ -410,6 +410,13 @@ pub fn choose(
         let summary = format!("config {} (role-named), bound to the skeleton", config.source);
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }
+    let source = format!("<derived for {robot}>");
+    let derived_here = || -> Result<IkConfig, Error> {
+        let roles = RobotRoles::recognise(model)?;
+        derive(model, &roles, &human_body(bvh, fk_options, "the skeleton")?, &source)
+    };
+    // The derived config, once made (the default solve checks the tuned one against it).
+    let mut derived = None;
     let mut why_not = String::new();
     if let Some(tuned) = tuned {
         let names = fk::body_names(bvh, fk_options)?;
@@ -435,12 +442,8 @@ pub fn choose(
                 None if gmr => None,
                 None => {
                     let roles = RobotRoles::recognise(model)?;
-                    let human = human_body(bvh, fk_options, "the skeleton")?;
-                    let derived = derive(model, &roles, &human, "")?;
-                    contradiction(tuned, &derived, &roles).map(|(body, angle)| {
-                        let degrees = angle.to_degrees();
-                        format!("it turns {body} {degrees:.0}° from the robot's joint frames")
-                    })
+                    let config = derived.insert(derived_here()?);
+                    contradiction(tuned, config, &roles).map(|c| c.to_string())
                 }
             };
             match reason {
@@ -457,12 +460,12 @@ pub fn choose(
             }
         }
     }
-    let roles = RobotRoles::recognise(model)?;
-    let human = human_body(bvh, fk_options, "the skeleton")?;
-    let source = format!("<derived for {robot}>");
-    let derived = derive(model, &roles, &human, &source)?;
+    let config = match derived {
+        Some(config) => config,
+        None => derived_here()?,
+    };
     let summary = format!("config derived from the roles of {robot} and of the skeleton{why_not}");
-    Ok(Chosen { config: derived, choice: Choice::Derived, summary })
+    Ok(Chosen { config, choice: Choice::Derived, summary })
 }
 
 /// Active entries of the first table (for tests and reports).
@@ -485,17 +488,31 @@ const CARRYING: [Part; 7] =
 /// arm frames (`shoulder::arm_turns`), ToddlerBot's hands by 94–150°.
 pub const CONTRADICTS: f64 = std::f64::consts::FRAC_PI_2;
 
+/// Where a tuned config contradicts the robot's joint frames ([`contradiction`]): the robot
+/// body of the row and how far (rad) its rotation offset is from the derived one's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contradiction {
+    pub body: String,
+    pub angle: f64,
+}
+
+impl std::fmt::Display for Contradiction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let degrees = self.angle.to_degrees();
+        write!(f, "it turns {} {degrees:.0}° from the robot's joint frames", self.body)
+    }
+}
+
 /// Where the `tuned` config contradicts the robot's joint frames (as the `derived` config
 /// for the same source has them): its row for a body that carries the robot (pelvis, trunk,
 /// legs) whose rotation offset is more than [`CONTRADICTS`] from the derived one's (same
-/// robot and human body, both with a rotation weight), the furthest, as `(robot body, angle
-/// in rad)`.
+/// robot and human body, both with a rotation weight), the furthest.
 #[must_use]
 pub fn contradiction(
     tuned: &IkConfig,
     derived: &IkConfig,
     roles: &RobotRoles,
-) -> Option<(String, f64)> {
+) -> Option<Contradiction> {
     let carrying = |body: &str| {
         roles.roles.iter().any(|(role, r)| r.name == body && CARRYING.contains(&role.part()))
     };
@@ -510,8 +527,9 @@ pub fn contradiction(
             let d = derived
                 .iter()
                 .find(|d| d.robot_body == t.robot_body && d.human_body == t.human_body)?;
-            Some((t.robot_body.clone(), t.rot_offset.angle_to(&d.rot_offset)))
+            let angle = t.rot_offset.angle_to(&d.rot_offset);
+            Some(Contradiction { body: t.robot_body, angle })
         })
-        .filter(|(_, angle)| *angle > CONTRADICTS)
-        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|c| c.angle > CONTRADICTS)
+        .max_by(|a, b| a.angle.total_cmp(&b.angle))
 }
