@@ -298,8 +298,7 @@ impl Constraint for SelfCollision {
 }
 
 /// A planted sole's point (`point`, body `body`'s frame) in one step: where the step may put it
-/// horizontally, `lo ..= hi` in x and y (world, m), and how far (`half_width`, m) a step may
-/// be asked to bring it back where it is outside. [`crate::ik::Solver`] makes these from the
+/// horizontally, `lo ..= hi` in x and y (world, m). [`crate::ik::Solver`] makes these from the
 /// foot plan's footholds ([`crate::ik::Solver::set_grips`]) and the previous frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GripBox {
@@ -307,15 +306,18 @@ pub struct GripBox {
     pub point: Vector3<f64>,
     pub lo: nalgebra::Vector2<f64>,
     pub hi: nalgebra::Vector2<f64>,
-    pub half_width: f64,
 }
 
 /// A planted foot does not slide: each of the step's [`GripBox`]es holds its point within
-/// its box, four rows `±(p + J Δq) ≥ …` in x and y; a point outside its box comes back
-/// towards it by at most the half width in a step (asked to come back whole in one step,
-/// Talos's root jumped metres in a frame on CMU 131_01's toe spin). Added last, so that
-/// where a frame cannot hold it with the floor, the robot's geoms apart and the speed
-/// limits, it is the one dropped for that step.
+/// its box, four rows `±(p + J Δq) ≥ …` in x and y; a point outside its box is held where it
+/// is on that side (its point task brings it back). Asked to come back, the four corners of
+/// a sole tipped onto its toes could be asked for a shape no small step makes: their rows
+/// nearly depend on each other, and the exact step of such a QP is huge. Asked back whole,
+/// Talos's root jumped metres in a frame on CMU 131_01's toe spin; asked back half the box,
+/// the H1's root 10.5 m in a frame of the second LAFAN1 take, and 17 cm in another (once
+/// the window's step no longer slid that sole). Added last, so that where a frame cannot
+/// hold it with the floor, the robot's geoms apart and the speed limits, it is the one
+/// dropped for that step.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Grip;
 
@@ -328,9 +330,9 @@ impl Constraint for Grip {
         for g in ctx.grips {
             let p = ctx.data.xpos[g.body] + ctx.data.xquat[g.body] * g.point;
             for axis in 0..2 {
-                // p + J Δq ≥ lo, and −(p + J Δq) ≥ −hi, each asking at most the half width.
+                // p + J Δq ≥ lo, and −(p + J Δq) ≥ −hi; past a bound, no further past it.
                 for (sign, b) in [(1.0, g.lo[axis] - p[axis]), (-1.0, p[axis] - g.hi[axis])] {
-                    let row = qp.add_row(b.min(g.half_width));
+                    let row = qp.add_row(b.min(0.0));
                     for (d, column) in ctx.model.jac_point_columns(ctx.data, g.body, p) {
                         row[d] = sign * column[axis];
                     }

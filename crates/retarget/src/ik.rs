@@ -439,7 +439,7 @@ impl<'m> Solver<'m> {
             let was = data.xpos[g.body] + data.xquat[g.body] * g.point;
             let half_width = slip * dt;
             let (lo, hi) = grip_bounds(&was, g, half_width);
-            self.grip_boxes.push(GripBox { body: g.body, point: g.point, lo, hi, half_width });
+            self.grip_boxes.push(GripBox { body: g.body, point: g.point, lo, hi });
         }
     }
 

@@ -591,3 +591,66 @@ fn a_planted_foot_holds_through_the_window_step() {
     let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
+
+/// A joint that the window's step would take past its range is held at its end in that step
+/// (`Trajectory::ranges_crossed`), not cut back once the step is taken: cut back alone, the
+/// H1's left hip roll, taken 0.1 rad past its range by the second iteration's step, slid the
+/// planted left sole 5 mm a frame for 0.12 s of the SMPL-X walk (120 fps), and its soles slid
+/// on the floor in 2.4 % of their floor frames (the corpus gate's cap: 2 %); 1.6 % held.
+#[test]
+fn a_joint_range_end_holds_in_the_window_step() {
+    let Some(dir) = shared::shared_file("reference/smpl") else { return };
+    let models = smpl::BodyModels::new(Some(&dir.join("body_models")));
+    let path = dir.join("motions/smplx_walk_stageii.npz");
+    let motion = smpl::SmplMotion::from_path(&path).unwrap();
+    let body = models.for_motion(&motion, None).unwrap();
+    let clip = smpl::clip(&body, &motion).unwrap();
+    let r = retarget::Retargeter::new("unitree_h1").unwrap();
+    let chosen = r.choose_smpl_config(&clip).unwrap();
+    let (robot, _) = r.retarget_smpl_with(&motion, &body, &clip, &chosen).unwrap();
+    let report = report(&robot, r.model(), &ReportOptions::default()).unwrap();
+    let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+    assert!(worst < 0.02, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
+}
+
+/// A gripped point outside its box is held where it is on that side, not asked back
+/// (`constraints::Grip`): asked back half the box, the corners of the H1's sole tipped onto
+/// its toes made a QP whose exact step is huge, and the sweep threw the root 10.5 m in a
+/// frame of the second LAFAN1 take (17,000 m/s²) and 17 cm in another (212 m/s²). The scaled
+/// human's root peaks at about 30 m/s² there.
+#[test]
+fn a_sweep_step_does_not_throw_the_root() {
+    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test2.bvh") else {
+        return;
+    };
+    let bvh = bvh::from_path(&path).unwrap();
+    let r = retarget::Retargeter::new("unitree_h1").unwrap();
+    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
+    let (nq, fps) = (motion.nq, motion.fps);
+    let root = |t: usize| nalgebra::Vector3::from_column_slice(&motion.qpos[t * nq..t * nq + 3]);
+    let (worst, at) = (1..motion.num_frames() - 1)
+        .map(|t| ((root(t + 1) - 2.0 * root(t) + root(t - 1)).norm() * fps * fps, t))
+        .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+    assert!(worst < 60.0, "the root accelerates at {worst:.0} m/s² in frame {at}");
+}
+
+/// A bound the window's step would cross is held in that step, constraint rows as well as
+/// joint ranges (`Trajectory::crossed`): with the ranges alone, the step carried ToddlerBot's
+/// left sole 4.1 cm into its right ankle in frames 3120–3121 of the LAFAN1 walk (1.75 m), a
+/// frame the sweep could not take back (its constraints relaxed).
+#[test]
+fn a_window_step_does_not_carry_a_sole_through_the_other_ankle() {
+    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+        return;
+    };
+    let bvh = bvh::from_path(&path).unwrap();
+    let r = retarget::Retargeter::new("stanford_toddy").unwrap().with_human_height(Some(1.75));
+    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
+    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
+    let sc = &report.self_collision;
+    assert_eq!(
+        sc.frames_deep, 0,
+        "{} frames deeper than 1 cm, {:.1} cm",
+        sc.frames_deep, sc.max_depth_cm
+    );
+}

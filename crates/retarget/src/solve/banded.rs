@@ -45,6 +45,24 @@ pub struct Banded {
     /// a diagonal block's reciprocal pivots ([`lower_inverse`]).
     nonzero: (Vec<usize>, Vec<usize>),
     reciprocal: Vec<f64>,
+    /// The system as [`Banded::save`] found it.
+    saved: Option<Saved>,
+}
+
+/// A copy of the system's blocks and right-hand side ([`Banded::save`]).
+#[derive(Debug, Clone)]
+struct Saved {
+    diag: Vec<DMatrix<f64>>,
+    sub1: Vec<DMatrix<f64>>,
+    sub2: Vec<DMatrix<f64>>,
+    rhs: DVector<f64>,
+}
+
+/// `to = from`, block by block (`to` of the same shapes).
+fn copy_blocks(to: &mut [DMatrix<f64>], from: &[DMatrix<f64>]) {
+    for (t, f) in to.iter_mut().zip(from) {
+        t.as_mut_slice().copy_from_slice(f.as_slice());
+    }
 }
 
 /// The factorisation met a block that is not positive definite (at this frame).
@@ -68,6 +86,7 @@ impl Banded {
             scratch: DMatrix::zeros(n, n),
             nonzero: (Vec::with_capacity(n), Vec::with_capacity(n)),
             reciprocal: vec![0.0; n],
+            saved: None,
         }
     }
 
@@ -140,6 +159,37 @@ impl Banded {
     pub fn rhs_mut(&mut self, t: usize) -> nalgebra::DVectorViewMut<'_, f64> {
         let n = self.n;
         self.rhs.rows_mut(t * n, n)
+    }
+
+    /// Keeps a copy of the system as it stands (before [`Banded::factor`] overwrites it), for
+    /// [`Banded::restore`].
+    pub fn save(&mut self) {
+        match &mut self.saved {
+            Some(saved) if saved.diag.len() == self.frames => {
+                copy_blocks(&mut saved.diag, &self.diag);
+                copy_blocks(&mut saved.sub1, &self.sub1);
+                copy_blocks(&mut saved.sub2, &self.sub2);
+                saved.rhs.copy_from(&self.rhs);
+            }
+            _ => {
+                self.saved = Some(Saved {
+                    diag: self.diag.clone(),
+                    sub1: self.sub1.clone(),
+                    sub2: self.sub2.clone(),
+                    rhs: self.rhs.clone(),
+                });
+            }
+        }
+    }
+
+    /// The system back as [`Banded::save`] kept it (nothing where nothing was kept): the same
+    /// system, to be added to and factored again, without assembling it again.
+    pub fn restore(&mut self) {
+        let Some(saved) = &self.saved else { return };
+        copy_blocks(&mut self.diag, &saved.diag);
+        copy_blocks(&mut self.sub1, &saved.sub1);
+        copy_blocks(&mut self.sub2, &saved.sub2);
+        self.rhs.copy_from(&saved.rhs);
     }
 
     /// Factorises in place. The blocks are overwritten; [`Banded::clear_couplings`] and new
@@ -328,11 +378,29 @@ mod tests {
         }
         let b = DVector::from_fn(size, |_, _| rnd());
         banded.rhs.copy_from(&b);
+        banded.save();
         banded.factor().unwrap();
         banded.solve();
         let x = dense.clone().cholesky().unwrap().solve(&b);
         assert!((&banded.rhs - &x).amax() < 1e-12, "{}", (&banded.rhs - &x).amax());
-        assert!((dense * &banded.rhs - b).amax() < 1e-12);
+        assert!((&dense * &banded.rhs - &b).amax() < 1e-12);
+        // Restored, with a penalty added: the system saved plus that term.
+        banded.restore();
+        let a: Vec<f64> = (0..n).map(|_| rnd()).collect();
+        banded.add_penalty(4, &a, None, 0.3, 50.0);
+        for i in 0..n {
+            for j in 0..n {
+                dense[(4 * n + i, 4 * n + j)] += 50.0 * a[i] * a[j];
+            }
+        }
+        let mut b = b;
+        for i in 0..n {
+            b[4 * n + i] += 50.0 * a[i] * 0.3;
+        }
+        banded.factor().unwrap();
+        banded.solve();
+        let x = dense.cholesky().unwrap().solve(&b);
+        assert!((&banded.rhs - &x).amax() < 1e-12, "{}", (&banded.rhs - &x).amax());
     }
 
     #[test]
