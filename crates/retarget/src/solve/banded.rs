@@ -182,13 +182,15 @@ impl Banded {
         }
     }
 
-    /// The system back as [`Banded::save`] kept it (nothing where nothing was kept): the same
-    /// system, to be added to and factored again, without assembling it again.
-    pub fn restore(&mut self) {
+    /// The system back as [`Banded::save`] kept it from frame `from` on, and its whole
+    /// right-hand side (nothing where nothing was kept): to be added to from that frame on and
+    /// factored again from there ([`Banded::factor_from`]), without assembling it again. The
+    /// factor of the frames before stands: theirs depends on no block after them.
+    pub fn restore_from(&mut self, from: usize) {
         let Some(saved) = &self.saved else { return };
-        copy_blocks(&mut self.diag, &saved.diag);
-        copy_blocks(&mut self.sub1, &saved.sub1);
-        copy_blocks(&mut self.sub2, &saved.sub2);
+        copy_blocks(&mut self.diag[from..], &saved.diag[from..]);
+        copy_blocks(&mut self.sub1[from..], &saved.sub1[from..]);
+        copy_blocks(&mut self.sub2[from..], &saved.sub2[from..]);
         self.rhs.copy_from(&saved.rhs);
     }
 
@@ -197,7 +199,13 @@ impl Banded {
     /// (The off-diagonal blocks are formed with the diagonal factors' inverses, products
     /// that run at matrix-multiply speed, where triangular solves by columns do not.)
     pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
-        for t in 0..self.frames {
+        self.factor_from(0)
+    }
+
+    /// [`Banded::factor`] of the frames from `from` on, those before already factored (by a
+    /// factorisation of the same blocks there: [`Banded::restore_from`]).
+    pub fn factor_from(&mut self, from: usize) -> Result<(), NotPositiveDefinite> {
+        for t in from..self.frames {
             if t >= 2 {
                 // L_{t,t−2} = A_{t,t−2} L_{t−2,t−2}⁻ᵀ
                 gemm_abt(&mut self.scratch, 1.0, &self.sub2[t], &self.inverse[t - 2], 0.0);
@@ -384,8 +392,8 @@ mod tests {
         let x = dense.clone().cholesky().unwrap().solve(&b);
         assert!((&banded.rhs - &x).amax() < 1e-12, "{}", (&banded.rhs - &x).amax());
         assert!((&dense * &banded.rhs - &b).amax() < 1e-12);
-        // Restored, with a penalty added: the system saved plus that term.
-        banded.restore();
+        // Restored from frame 4, with a penalty added there: the system saved plus that term.
+        banded.restore_from(4);
         let a: Vec<f64> = (0..n).map(|_| rnd()).collect();
         banded.add_penalty(4, &a, None, 0.3, 50.0);
         for i in 0..n {
@@ -397,7 +405,7 @@ mod tests {
         for i in 0..n {
             b[4 * n + i] += 50.0 * a[i] * 0.3;
         }
-        banded.factor().unwrap();
+        banded.factor_from(4).unwrap();
         banded.solve();
         let x = dense.cholesky().unwrap().solve(&b);
         assert!((&banded.rhs - &x).amax() < 1e-12, "{}", (&banded.rhs - &x).amax());

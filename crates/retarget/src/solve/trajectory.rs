@@ -293,6 +293,15 @@ enum Crossed {
     Row { k: usize, row: usize },
 }
 
+impl Crossed {
+    /// The window frame it is held in (its terms touch that frame's block alone).
+    fn frame(self) -> usize {
+        match self {
+            Crossed::Range { k, .. } | Crossed::Row { k, .. } => k,
+        }
+    }
+}
+
 impl<'s, 'm> Trajectory<'s, 'm> {
     pub(crate) fn new(
         solver: &'s mut Solver<'m>,
@@ -479,11 +488,13 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let mut held: Vec<Crossed> = Vec::new();
         self.assemble(frames, first, seq)?;
         for round in 0..=CROSSED_ROUNDS {
-            // (Each round solves the same system with more held: kept, not assembled again.)
+            // Each round solves the same system with more held: kept, not assembled again,
+            // and factored again from the first frame with a bound held on.
+            let from = held.iter().map(|c| c.frame()).min().unwrap_or(0);
             if round == 0 {
                 self.banded.save();
             } else {
-                self.banded.restore();
+                self.banded.restore_from(from);
             }
             let rho = self.options.active_penalty;
             for &c in &held {
@@ -499,7 +510,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                     }
                 }
             }
-            if self.banded.factor().is_err() {
+            if self.banded.factor_from(from).is_err() {
                 return Err(Error::numerical(
                     first,
                     "the trajectory's quadratic model is not positive definite".to_owned(),
