@@ -162,7 +162,7 @@ impl Banded {
     }
 
     /// Keeps a copy of the system as it stands (before [`Banded::factor`] overwrites it), for
-    /// [`Banded::restore`].
+    /// [`Banded::restore_from`].
     pub fn save(&mut self) {
         match &mut self.saved {
             Some(saved) if saved.diag.len() == self.frames => {
