@@ -154,11 +154,6 @@ fn coordinate_weights(model: &Model, options: &TrajectoryOptions) -> Vec<f64> {
     w
 }
 
-/// A banded step is solved again at most this many times with the bounds it crossed held
-/// ([`Trajectory::crossed`]). (Three: the corpus gate flagged 86 rows rather than 85, and
-/// CMU 131_03 onto the G1 took 1.28 s of user time against 0.74 s.)
-const CROSSED_ROUNDS: usize = 1;
-
 /// The joints' tracking stiffness is averaged over every this many frames of a window.
 const STIFFNESS_STRIDE: usize = 4;
 
@@ -284,7 +279,7 @@ pub(crate) struct Trajectory<'s, 'm> {
 }
 
 /// A bound the banded step would cross, held in the system solved again
-/// ([`Trajectory::crossed`]).
+/// ([`Trajectory::crossed`], [`Trajectory::hold`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Crossed {
     /// Frame `k`'s dof `dof` at a range end, `to` the step there.
@@ -426,12 +421,13 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         Ok(())
     }
 
-    /// Adds to `held` every bound that the solved step (`banded.rhs`) takes further than the
-    /// slack past and that is not held yet: joint range ends, and the loose rows.
-    fn crossed(&self, seq: &Sequence<'_>, held: &mut Vec<Crossed>) {
+    /// Every bound that the solved step (`banded.rhs`) takes further than the slack past:
+    /// joint range ends, and the loose rows.
+    fn crossed(&self, seq: &Sequence<'_>) -> Vec<Crossed> {
         let model = self.solver.robot();
         let (nq, nv) = (model.nq, model.nv);
         let slack = self.options.active_slack;
+        let mut crossed = Vec::new();
         for k in 0..seq.qpos.len() / nq {
             let q = &seq.qpos[k * nq..(k + 1) * nq];
             let step = &self.banded.rhs.as_slice()[k * nv..(k + 1) * nv];
@@ -450,22 +446,49 @@ impl<'s, 'm> Trajectory<'s, 'm> {
                 } else {
                     continue;
                 };
-                let c = Crossed::Range { k, dof, to: bound - v };
-                if !held.iter().any(
-                    |h| matches!(*h, Crossed::Range { k: hk, dof: hd, .. } if hk == k && hd == dof),
-                ) {
-                    held.push(c);
-                }
+                crossed.push(Crossed::Range { k, dof, to: bound - v });
             }
             let (a, b) = &self.loose[k];
             for (row, (a, &b)) in a.chunks_exact(nv).zip(b).enumerate() {
                 let reach: f64 = a.iter().zip(step).map(|(a, s)| a * s).sum();
-                let c = Crossed::Row { k, row };
-                if reach < b - slack && !held.contains(&c) {
-                    held.push(c);
+                if reach < b - slack {
+                    crossed.push(Crossed::Row { k, row });
                 }
             }
         }
+        crossed
+    }
+
+    /// Adds the stiff penalty that holds each of `crossed` at its bound.
+    fn hold(&mut self, crossed: &[Crossed]) {
+        let nv = self.solver.robot().nv;
+        let rho = self.options.active_penalty;
+        for &c in crossed {
+            match c {
+                Crossed::Range { k, dof, to } => {
+                    self.banded.add(k, 0, dof, dof, rho);
+                    self.banded.rhs_mut(k)[dof] += rho * to;
+                }
+                Crossed::Row { k, row } => {
+                    let (a, b) = &self.loose[k];
+                    let a = &a[row * nv..(row + 1) * nv];
+                    self.banded.add_penalty(k, a, None, b[row], rho);
+                }
+            }
+        }
+    }
+
+    /// Factors the banded system from frame `from` on and solves it (`banded.rhs` becomes
+    /// the step).
+    fn factor_and_solve(&mut self, first: usize, from: usize) -> Result<(), Error> {
+        if self.banded.factor_from(from).is_err() {
+            return Err(Error::numerical(
+                first,
+                "the trajectory's quadratic model is not positive definite".to_owned(),
+            ));
+        }
+        self.banded.solve();
+        Ok(())
     }
 
     /// One Gauss–Newton step of the whole window: the banded system assembled at the current
@@ -485,45 +508,16 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         // joint alone, which slides a planted sole (a hip roll the step took 0.1 rad past its
         // range onto the H1, 5 mm a frame at 120 fps), and a row left out lets the step carry
         // a geom through the floor or another that the sweep then cannot take back.
-        let mut held: Vec<Crossed> = Vec::new();
         self.assemble(frames, first, seq)?;
-        for round in 0..=CROSSED_ROUNDS {
-            // Each round solves the same system with more held: kept, not assembled again,
-            // and factored again from the first frame with a bound held on.
-            let from = held.iter().map(|c| c.frame()).min().unwrap_or(0);
-            if round == 0 {
-                self.banded.save();
-            } else {
-                self.banded.restore_from(from);
-            }
-            let rho = self.options.active_penalty;
-            for &c in &held {
-                match c {
-                    Crossed::Range { k, dof, to } => {
-                        self.banded.add(k, 0, dof, dof, rho);
-                        self.banded.rhs_mut(k)[dof] += rho * to;
-                    }
-                    Crossed::Row { k, row } => {
-                        let (a, b) = &self.loose[k];
-                        let a = &a[row * nv..(row + 1) * nv];
-                        self.banded.add_penalty(k, a, None, b[row], rho);
-                    }
-                }
-            }
-            if self.banded.factor_from(from).is_err() {
-                return Err(Error::numerical(
-                    first,
-                    "the trajectory's quadratic model is not positive definite".to_owned(),
-                ));
-            }
-            self.banded.solve();
-            let before = held.len();
-            if round < CROSSED_ROUNDS {
-                self.crossed(seq, &mut held);
-            }
-            if held.len() == before {
-                break;
-            }
+        self.banded.save();
+        self.factor_and_solve(first, 0)?;
+        let crossed = self.crossed(seq);
+        // Solved again with them held: the system kept, not assembled again, and factored
+        // again from the first frame with a bound held on (the factor before it stands).
+        if let Some(from) = crossed.iter().map(|c| c.frame()).min() {
+            self.banded.restore_from(from);
+            self.hold(&crossed);
+            self.factor_and_solve(first, from)?;
         }
         // A trust region: the whole step is scaled so that no coordinate moves further than
         // `max_step` (a Gauss–Newton step from a poor linearisation, a limb's branch or a
@@ -537,8 +531,8 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             let q = &mut seq.qpos[k * nq..(k + 1) * nq];
             model.integrate_pos(q, step.as_slice(), 1.0);
             // The joint ranges are a box: what the step still crosses (within the slack, or
-            // after the last round) is projected onto it (the sweep's bounds only close 95 %
-            // of a gap, as GMR's do).
+            // once solved again) is projected onto it (the sweep's bounds only close 95 % of
+            // a gap, as GMR's do).
             for joint in &model.joints {
                 if let (JointType::Hinge | JointType::Slide, Some([lo, hi])) =
                     (joint.kind, joint.range)
