@@ -124,7 +124,7 @@ impl<'m> Solver<'m> {
     }
 
     /// One step of the trajectory solve's frame subproblem from the current configuration
-    /// (two where the first ends more than 5 mm past a constraint other than the grips):
+    /// (two where the first ends more than 5 mm past a constraint):
     /// the tracking objective of `stages`, the point tasks, the extra terms ([`Solver::set_extra`]),
     /// the joint ranges, the speed limits from the frame before ([`Solver::set_previous`]) and
     /// towards the one after ([`Solver::set_next`]), and every constraint. Returns the steps
@@ -177,28 +177,17 @@ impl<'m> Solver<'m> {
         status
     }
 
-    /// How far (m) the current configuration is past the constraints other than the grips
-    /// (their rows made here: the floor, the robot's geoms apart), 0 where within them all.
+    /// How far (m) the current configuration is past its constraints (their rows made here:
+    /// the floor, the robot's geoms apart), 0 where within them all. A grip's rows never are:
+    /// past its box, a point is held where it is ([`crate::constraints::Grip`]).
     fn past_constraints(&mut self) -> f64 {
         if self.constraints.is_empty() {
             return 0.0;
         }
         self.make_rows();
         self.rows_made = false;
-        let mut past = 0.0f64;
-        let mut first = 0;
-        for (c, &end) in self.constraints.iter().zip(&self.row_ends) {
-            if c.name() != "grip" {
-                for k in first..end {
-                    // A row `a · Δq ≥ b` at Δq = 0: past it by b.
-                    if let Some((_, b)) = self.dense.row(k) {
-                        past = past.max(b);
-                    }
-                }
-            }
-            first = end;
-        }
-        past
+        // A row `a · Δq ≥ b` at Δq = 0: past it by b.
+        (0..self.dense.num_rows()).filter_map(|k| self.dense.row(k)).fold(0.0, |p, (_, b)| p.max(b))
     }
 
     /// Diagnostics of the current configuration against `targets`: tracking errors and the
