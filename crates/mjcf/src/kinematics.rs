@@ -263,18 +263,26 @@ impl Model {
         }
         jacp[..3 * nv].fill(0.0);
         jacr[..3 * nv].fill(0.0);
+        self.write_chain(data, body, point, jacp, jacr);
+    }
+
+    /// The columns of the dofs on `body`'s path to the world of the Jacobians at `point`
+    /// ([`Model::jac_column`]) into `jacp` and `jacr` (`3 × nv` row-major; sizes checked by
+    /// the callers).
+    fn write_chain(
+        &self,
+        data: &Data,
+        body: usize,
+        point: &Vector3<f64>,
+        jacp: &mut [f64],
+        jacr: &mut [f64],
+    ) {
+        let nv = self.nv;
         for d in self.body_dofs(body) {
-            let axis = data.dof_axis[d];
-            if data.dof_linear[d] {
-                for r in 0..3 {
-                    jacp[r * nv + d] = axis[r];
-                }
-            } else {
-                let v = axis.cross(&(point - data.dof_anchor[d]));
-                for r in 0..3 {
-                    jacp[r * nv + d] = v[r];
-                    jacr[r * nv + d] = axis[r];
-                }
+            let Some((p, r)) = Self::jac_column(data, point, d) else { continue };
+            for k in 0..3 {
+                jacp[k * nv + d] = p[k];
+                jacr[k * nv + d] = r[k];
             }
         }
     }
@@ -288,18 +296,7 @@ impl Model {
         if jacp.len() < 3 * nv || jacr.len() < 3 * nv || data.dof_axis.len() != nv {
             return;
         }
-        for d in self.body_dofs(body) {
-            let axis = data.dof_axis[d];
-            let (p, r) = if data.dof_linear[d] {
-                (axis, Vector3::zeros())
-            } else {
-                (axis.cross(&(point - data.dof_anchor[d])), axis)
-            };
-            for k in 0..3 {
-                jacp[k * nv + d] = p[k];
-                jacr[k * nv + d] = r[k];
-            }
-        }
+        self.write_chain(data, body, &point, jacp, jacr);
     }
 
     /// Column `d` of [`Model::jac_chain`]'s `jacp` and `jacr` for a body at `point` (its
@@ -334,12 +331,9 @@ impl Model {
         point: Vector3<f64>,
     ) -> impl Iterator<Item = (usize, Vector3<f64>)> + 'a {
         let sized = data.dof_axis.len() == self.nv && data.dof_linear.len() == self.nv;
-        self.body_dofs(body).take_while(move |_| sized).map(move |d| {
-            let axis = data.dof_axis[d];
-            let column =
-                if data.dof_linear[d] { axis } else { axis.cross(&(point - data.dof_anchor[d])) };
-            (d, column)
-        })
+        self.body_dofs(body)
+            .take_while(move |_| sized)
+            .filter_map(move |d| Some((d, Self::jac_column(data, &point, d)?.0)))
     }
 
     /// `mj_integratePos`: `qpos ← qpos ⊕ qvel dt`. Hinge and slide add; ball and the free
