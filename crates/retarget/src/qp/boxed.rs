@@ -102,15 +102,9 @@ impl BoxQp {
     /// `mj_factorI` (`H = Lᵀ D L` eliminating leaves first, no fill-in) instead of a dense
     /// Cholesky. Ignored unless `parent` has `n` entries, each lower than its index.
     pub fn set_tree(&mut self, parent: Vec<Option<usize>>) {
-        let ok = parent.len() == self.n
-            && parent.iter().enumerate().all(|(i, p)| p.is_none_or(|p| p < i));
-        self.chains = if ok {
-            (0..self.n)
-                .map(|i| std::iter::successors(parent[i], |&p| parent[p]).collect())
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let chains = super::ancestor_chains(&parent, self.n);
+        self.tree = chains.is_some();
+        self.chains = chains.unwrap_or_default();
         self.row_adr = self
             .chains
             .iter()
@@ -122,7 +116,6 @@ impl BoxQp {
             .collect();
         let len = self.chains.iter().map(|chain| chain.len() + 1).sum();
         self.packed = vec![0.0; len];
-        self.tree = ok;
     }
 
     /// Whether variable `i` ended on one of its bounds (in the working set).

@@ -153,13 +153,8 @@ impl DenseQp {
     /// the active set touch its columns, is stored. Ignored unless `parent` has `n` entries,
     /// each lower than its index.
     pub fn set_tree(&mut self, parent: &[Option<usize>]) {
-        let n = self.n;
-        let ok =
-            parent.len() == n && parent.iter().enumerate().all(|(i, p)| p.is_none_or(|p| p < i));
-        if ok {
-            self.chains = (0..n)
-                .map(|i| std::iter::successors(parent[i], |&p| parent[p]).collect())
-                .collect();
+        if let Some(chains) = super::ancestor_chains(parent, self.n) {
+            self.chains = chains;
             self.tree_start = self
                 .chains
                 .iter()

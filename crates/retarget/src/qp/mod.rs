@@ -14,6 +14,14 @@ mod dual;
 pub use boxed::{BoxQp, QpStatus};
 pub use dual::DenseQp;
 
+/// Per variable of the tree `parent`, its ancestors nearest first (the rows of both solvers'
+/// tree factorisations); `None` unless `parent` has `n` entries, each lower than its index.
+fn ancestor_chains(parent: &[Option<usize>], n: usize) -> Option<Vec<Vec<usize>>> {
+    let tree = parent.len() == n && parent.iter().enumerate().all(|(i, p)| p.is_none_or(|p| p < i));
+    let up = |p: &usize| parent.get(*p).copied().flatten();
+    tree.then(|| parent.iter().map(|p| std::iter::successors(*p, up).collect()).collect())
+}
+
 /// A random tree over `n` dofs (parents before children, several roots) and an `H` with its
 /// sparsity: a sum of outer products of rows along root-to-leaf chains, plus `ridge` on the
 /// diagonal. Test problems of both solvers' tree factorisations.
