@@ -21,6 +21,12 @@ fn g1() -> mjcf::Model {
     model
 }
 
+/// The worse foot's share of floor frames whose contact point slides (the corpus gate's
+/// `floor_skating`).
+fn worst_floor_skating(report: &QualityReport) -> f64 {
+    report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max)
+}
+
 /// Frames `range` of `full`.
 fn slice(full: &fk::HumanMotion, range: std::ops::Range<usize>) -> fk::HumanMotion {
     let nb = full.num_bodies();
@@ -541,8 +547,7 @@ fn the_same_walk_at_30_60_and_120_fps_gives_the_same_motion() {
         }
         let p95 = retarget::report::percentile(&joints, 0.95);
         let share = |r: &QualityReport| r.dynamics.as_ref().unwrap().share_over;
-        let skate =
-            |r: &QualityReport| r.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+        let skate = worst_floor_skating;
         eprintln!(
             "{} fps: joints p95 {p95:.4} rad, root max {root:.4} m, dynamics {:.3} vs {:.3}, floor skating {:.4} vs {:.4}",
             30 * factor,
@@ -570,7 +575,7 @@ fn planted_feet_hold_at_120_fps() {
     let (motion, _) = r.retarget_bvh(&bvh).unwrap();
     assert!((motion.fps - 120.0).abs() < 1e-6, "{}", motion.fps);
     let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
-    let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+    let worst = worst_floor_skating(&report);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
 
@@ -588,7 +593,7 @@ fn a_planted_foot_holds_through_the_window_step() {
     let r = retarget::Retargeter::new("booster_t1_29dof").unwrap();
     let (motion, _) = r.retarget_bvh(&bvh).unwrap();
     let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
-    let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+    let worst = worst_floor_skating(&report);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
 
@@ -609,7 +614,7 @@ fn a_joint_range_end_holds_in_the_window_step() {
     let chosen = r.choose_smpl_config(&clip).unwrap();
     let (robot, _) = r.retarget_smpl_with(&motion, &body, &clip, &chosen).unwrap();
     let report = report(&robot, r.model(), &ReportOptions::default()).unwrap();
-    let worst = report.feet.iter().map(|f| f.floor_skating_share).fold(0.0, f64::max);
+    let worst = worst_floor_skating(&report);
     assert!(worst < 0.02, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
 
