@@ -8,7 +8,7 @@
 // `HumanMotion::validate` first.
 #![allow(clippy::indexing_slicing)]
 
-use mjcf::{JointType, Model};
+use mjcf::Model;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::pipeline::Pipeline;
@@ -227,10 +227,8 @@ impl crate::solve::trajectory::Frames for Problem<'_> {
         self.set_frame_tasks(solver, frame)
     }
 
-    fn root_reference(&self, frame: usize) -> Option<(Pose, bool)> {
-        let free = self.clip.model.joints.iter().find(|j| j.kind == JointType::Free)?;
-        let body = self.root_body()?;
-        Some((self.frame_targets(frame)[self.clip.root_target], body == free.body))
+    fn root_reference(&self, frame: usize) -> Option<(Pose, usize)> {
+        Some((self.frame_targets(frame)[self.clip.root_target], self.root_body()?))
     }
 }
 

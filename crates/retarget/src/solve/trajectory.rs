@@ -42,7 +42,7 @@
 #![allow(clippy::indexing_slicing)]
 
 use mjcf::{Data, JointType, Model};
-use nalgebra::DVectorView;
+use nalgebra::{DVectorView, Vector3};
 
 use super::banded::Banded;
 use super::dynamics_term::{Centroidal, DynamicsOptions, FrameState};
@@ -136,9 +136,9 @@ pub(crate) trait Frames {
     fn targets(&self, frame: usize) -> &[Pose];
     fn configure(&self, solver: &mut Solver<'_>, frame: usize) -> Result<(), Error>;
     /// The pose the human root's task follows in `frame` (its target), if there is one, and
-    /// whether that task is on the free root's body: the root's accelerations are measured
-    /// against this pose's (the rotation's only when the task is on the root's own body).
-    fn root_reference(&self, frame: usize) -> Option<(Pose, bool)>;
+    /// the body that task is on: the root's accelerations are measured against this pose's,
+    /// at that body's origin (the rotation's only when the task is on the free root's body).
+    fn root_reference(&self, frame: usize) -> Option<(Pose, usize)>;
 }
 
 /// Per velocity coordinate, its acceleration weight (before `1 / dt⁴`).
@@ -186,7 +186,8 @@ fn objective_stages(solver_stages: usize, options: &TrajectoryOptions) -> Vec<(u
 /// is `first` (see [`Sequence::reference`]): the free root's, from [`Frames::root_reference`]
 /// (its translation's second difference in the world, its rotation's of the body-frame
 /// rotation vectors, as [`Model::differentiate_pos`] measures the root's), where the three
-/// frames around have one.
+/// frames around have one. (The translation's is the reference of the root task's body's
+/// origin, [`Trajectory::root_point_terms`], where that body is not the free root's.)
 fn reference_accelerations(
     model: &Model,
     frames: &dyn Frames,
@@ -199,7 +200,10 @@ fn reference_accelerations(
     let mut out = vec![0.0; len * nv];
     let Some(root) = model.joints.iter().find(|j| j.kind == JointType::Free) else { return out };
     let d = root.dof_adr;
-    let pose = |j: usize| (first + j).checked_sub(fixed).and_then(|f| frames.root_reference(f));
+    let pose = |j: usize| {
+        let f = (first + j).checked_sub(fixed)?;
+        frames.root_reference(f).map(|(pose, body)| (pose, body == root.body))
+    };
     let poses: Vec<Option<(Pose, bool)>> = (0..len).map(pose).collect();
     let velocity = |a: &Pose, b: &Pose| {
         let qa = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
@@ -276,6 +280,28 @@ pub(crate) struct Trajectory<'s, 'm> {
     /// Per window frame, the constraint rows not held (further than the slack from their
     /// bound where the step is linearised): `a` (`rows × nv`) and `b` of `a · δ ≥ b`.
     loose: Vec<(Vec<f64>, Vec<f64>)>,
+    /// The body whose origin the root's translational acceleration is measured at, where the
+    /// root task is on a body other than the free root's (the T1's `Waist` under its
+    /// `Trunk`): its target is that origin's, and the report measures it there.
+    root_point: Option<usize>,
+    /// Per sequence frame, that origin and its Jacobian ([`Trajectory::root_point_terms`]).
+    points: Vec<RootPoint>,
+    /// Kinematics of the frames the solver is not at, for [`Trajectory::points`].
+    point_data: Data,
+}
+
+/// A body's origin in one frame and its Jacobian's non-zero columns (dof, column).
+#[derive(Debug, Clone, Default)]
+struct RootPoint {
+    at: Vector3<f64>,
+    columns: Vec<(usize, Vector3<f64>)>,
+}
+
+impl RootPoint {
+    fn of(model: &Model, data: &Data, body: usize) -> RootPoint {
+        let at = data.xpos[body];
+        RootPoint { at, columns: model.jac_point_columns(data, body, at).collect() }
+    }
 }
 
 /// A bound the banded step would cross, held in the system solved again
@@ -319,6 +345,9 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             before: Data::new(model),
             before_for: None,
             loose: Vec::new(),
+            root_point: None,
+            points: Vec::new(),
+            point_data: Data::new(model),
             solver,
         }
     }
@@ -326,6 +355,20 @@ impl<'s, 'm> Trajectory<'s, 'm> {
     /// Frames per window and their overlap at this frame rate.
     pub(crate) fn window_frames(&self) -> (usize, usize) {
         window_frames(&self.options, 1.0 / self.dt)
+    }
+
+    /// Where the root's translational acceleration is measured in the window starting at
+    /// frame `first`: at the free root's coordinates where the root task is on the free
+    /// root's body (or there is none), else at the task's body's origin
+    /// ([`Trajectory::root_point`], whose term then carries the weight).
+    fn root_point(&mut self, frames: &dyn Frames, first: usize) {
+        let model = self.solver.robot();
+        let Some(free) = model.joints.iter().find(|j| j.kind == JointType::Free) else { return };
+        let body = frames.root_reference(first).map(|(_, body)| body);
+        self.root_point = body.filter(|&b| b != free.body);
+        let w = if self.root_point.is_some() { 0.0 } else { self.options.root_translation };
+        let d = free.dof_adr;
+        self.weight[d..d + 3].fill(w / self.dt.powi(4));
     }
 
     /// Solves frames `first..first + n` (`qpos`: their configurations, `n × nq`, the initial
@@ -345,6 +388,7 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         }
         let reference = reference_accelerations(model, frames, first, fixed.len(), n);
         let mut seq = Sequence { nq: model.nq, fixed, qpos, reference };
+        self.root_point(frames, first);
         self.joint_weights(frames, first, &seq)?;
         let mut diagnostics = Vec::new();
         for _ in 0..self.options.iterations {
@@ -408,14 +452,27 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         self.banded.clear_couplings();
         self.before_for = None;
         self.fixed_states(seq);
+        if let Some(body) = self.root_point {
+            let model = self.solver.robot();
+            self.points.resize(seq.len(), RootPoint::default());
+            for (j, q) in seq.fixed.iter().enumerate() {
+                model.body_kinematics(q, &mut self.point_data);
+                self.points[j] = RootPoint::of(model, &self.point_data, body);
+            }
+        }
         for k in 0..n {
             self.frame_terms(frames, first + k, k, &seq.qpos[k * nq..(k + 1) * nq])?;
             self.record_state(seq.fixed.len() + k);
+            if let Some(body) = self.root_point {
+                let point = RootPoint::of(self.solver.robot(), self.solver.data(), body);
+                self.points[seq.fixed.len() + k] = point;
+            }
             // The frame before, `dt` earlier (none before the clip's first frame).
             let before = (seq.fixed.len() + k).checked_sub(1).map(|j| seq.at(j));
             self.grip_terms(k, before);
         }
         self.smoothness_terms(seq);
+        self.root_point_terms(seq);
         self.speed_terms(seq);
         self.dynamics_terms(seq.fixed.len());
         Ok(())
@@ -753,6 +810,51 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         }
     }
 
+    /// `½ W |a_t|²` of the root task's body's origin `p` (when [`Trajectory::root_point`]),
+    /// `a_t = p_{t+1} − 2 p_t + p_{t−1}` less the reference's, over the sequence's interior
+    /// frames, linearised through each frame's Jacobian `J` (`p_s(δ) = p_s + J_s δ_s`), `W`
+    /// the root's translational weight: the root's acceleration where its target is, not at
+    /// the free root's origin, which the trunk's turns move past it (the T1's `Trunk` origin
+    /// sits 13 cm from its `Waist`: on the LAFAN1 walk the `Waist` accelerated 1.47 × its
+    /// target, the `Trunk` origin 1.26 ×).
+    fn root_point_terms(&mut self, seq: &Sequence<'_>) {
+        let Some(free) = self.solver.robot().joints.iter().find(|j| j.kind == JointType::Free)
+        else {
+            return;
+        };
+        if self.root_point.is_none() {
+            return;
+        }
+        let d = free.dof_adr;
+        let nv = self.solver.robot().nv;
+        let w = self.options.root_translation / self.dt.powi(4);
+        let offset = seq.fixed.len();
+        const COEF: [f64; 3] = [1.0, -2.0, 1.0];
+        for t in 1..seq.len().saturating_sub(1) {
+            let p = |x: usize| self.points[t + x - 1].at;
+            let aref = Vector3::from_column_slice(&seq.reference[t * nv + d..t * nv + d + 3]);
+            let a = p(2) - p(1) * 2.0 + p(0) - aref;
+            for (x, &cx) in COEF.iter().enumerate() {
+                let Some(kx) = (t + x - 1).checked_sub(offset) else { continue };
+                let mut rhs = self.banded.rhs_mut(kx);
+                for (dof, column) in &self.points[t + x - 1].columns {
+                    rhs[*dof] -= w * cx * column.dot(&a);
+                }
+                for (y, &cy) in COEF.iter().enumerate().take(x + 1) {
+                    if (t + y - 1) < offset {
+                        continue;
+                    }
+                    let block = self.banded.block_mut(kx, x - y);
+                    for (dx, cx_col) in &self.points[t + x - 1].columns {
+                        for (dy, cy_col) in &self.points[t + y - 1].columns {
+                            block[(*dx, *dy)] += w * cx * cy * cx_col.dot(cy_col);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Per consecutive pair of the sequence, `q_j ⊖ q_{j−1}` (`(len − 1) × nv`).
     fn velocities(&self, seq: &Sequence<'_>) -> Vec<f64> {
         let model = self.solver.robot();
@@ -794,6 +896,34 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         }
     }
 
+    /// The sweep's part of [`Trajectory::root_point_terms`] for sequence frame `j`, the
+    /// solver at its configuration and its neighbours held: `½ W |c J_j δ + a_t|²` for the
+    /// accelerations `a_t` that involve it (`c`: its coefficient in each), into the frame's
+    /// extra quadratic (`h`, `nv × nv` row-major, and `c`).
+    fn root_point_pull(&self, seq: &Sequence<'_>, j: usize, h: &mut [f64], c: &mut [f64]) {
+        let Some(body) = self.root_point else { return };
+        let model = self.solver.robot();
+        let Some(free) = model.joints.iter().find(|j| j.kind == JointType::Free) else { return };
+        let (nv, d, len) = (model.nv, free.dof_adr, seq.len());
+        let w = self.options.root_translation / self.dt.powi(4);
+        let here = RootPoint::of(model, self.solver.data(), body);
+        for t in [j.wrapping_sub(1), j, j + 1] {
+            if t == usize::MAX || t == 0 || t + 1 >= len {
+                continue;
+            }
+            let c_self = if t == j { -2.0 } else { 1.0 };
+            let aref = Vector3::from_column_slice(&seq.reference[t * nv + d..t * nv + d + 3]);
+            let p = |x: usize| if x == j { here.at } else { self.points[x].at };
+            let a = p(t + 1) - p(t) * 2.0 + p(t - 1) - aref;
+            for (dx, cx) in &here.columns {
+                c[*dx] += w * c_self * cx.dot(&a);
+                for (dy, cy) in &here.columns {
+                    h[dx * nv + dy] += w * c_self * c_self * cx.dot(cy);
+                }
+            }
+        }
+    }
+
     /// One forward sweep: each frame's subproblem solved exactly (one constrained step), its
     /// neighbours held: the smoothness terms that involve the frame are a pull of its step
     /// towards the one that minimises them, and the dynamics terms a quadratic of their own
@@ -812,6 +942,15 @@ impl<'s, 'm> Trajectory<'s, 'm> {
         let mut diagnostics = Vec::with_capacity(n);
         let mut weights = vec![0.0; nv];
         let mut target = vec![0.0; nv];
+        // The root task's body's origin in every frame as it is now (the frames before `j`
+        // as this sweep left them).
+        if let Some(body) = self.root_point {
+            self.points.resize(len, RootPoint::default());
+            for j in 0..len {
+                model.body_kinematics(seq.at(j), &mut self.point_data);
+                self.points[j] = RootPoint::of(model, &self.point_data, body);
+            }
+        }
         for k in 0..n {
             let j = k + offset;
             // Tangents at q_j towards each neighbour within two frames.
@@ -852,10 +991,11 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             for i in 0..nv {
                 extra_h[i * nv + i] = weights[i];
             }
-            let extra_c: Vec<f64> = target.iter().map(|t| -t).collect();
+            let mut extra_c: Vec<f64> = target.iter().map(|t| -t).collect();
             let q = seq.at(j).to_vec();
             self.solver.set_qpos(&q)?;
             frames.configure(self.solver, first + k)?;
+            self.root_point_pull(seq, j, &mut extra_h, &mut extra_c);
             self.solver.set_extra(&extra_h, &extra_c)?;
             let previous = if j >= 1 { seq.at(j - 1).to_vec() } else { q.clone() };
             self.solver.set_previous(&previous)?;
@@ -865,6 +1005,10 @@ impl<'s, 'm> Trajectory<'s, 'm> {
             let (relaxed, _) =
                 self.solver.trajectory_step(&self.stages, frames.targets(first + k), dt)?;
             seq.qpos[k * nq..(k + 1) * nq].copy_from_slice(self.solver.qpos());
+            if let Some(body) = self.root_point {
+                model.body_kinematics(seq.at(j), &mut self.point_data);
+                self.points[j] = RootPoint::of(model, &self.point_data, body);
+            }
             diagnostics.push(self.solver.diagnostics(frames.targets(first + k), relaxed)?);
         }
         self.solver.set_extra(&[], &[])?;
