@@ -13,7 +13,9 @@
 //! ```
 //!
 //! `W` weighs the acceleration of every velocity coordinate, the free root's translation and
-//! rotation included ([`TrajectoryOptions`]). Gauss–Newton: each iteration linearises the
+//! rotation included ([`TrajectoryOptions`]); the root's translation is measured where its
+//! target is, at the origin of the body the root task is on, when that is not the free root's
+//! body (`Trajectory::root_point_terms`). Gauss–Newton: each iteration linearises the
 //! tasks at the current trajectory and solves the window's quadratic model in one piece, a
 //! block-pentadiagonal system (`banded.rs`: a second difference couples three frames)
 //! in which the constraints that are active (within [`TrajectoryOptions::active_slack`] of
@@ -54,8 +56,9 @@ use crate::Error;
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct TrajectoryOptions {
-    /// Weight of the free root's linear acceleration, per (m/s²)²: an acceleration of
-    /// `sqrt(1 / w)` m/s² costs as much as one unit of the tracking objective.
+    /// Weight of the root's linear acceleration, per (m/s²)²: an acceleration of
+    /// `sqrt(1 / w)` m/s² costs as much as one unit of the tracking objective. Measured at the
+    /// origin of the body the root task is on (the free root's, or the T1's `Waist`).
     pub root_translation: f64,
     /// Weight of the free root's angular acceleration, per (rad/s²)².
     pub root_rotation: f64,
