@@ -2,7 +2,8 @@
 //! [`FootPlanOptions::lift_s`] after lift-off and left over as long before touch-down; while
 //! it rises (comes down), the sole points that stood on the floor at lift-off (stand on it at
 //! touch-down) are held where they were (will be), seen from above: a foot leaves the floor
-//! by lifting, not sliding, its last contact.
+//! by lifting, not sliding, its last contact (after lift-off by the solve's grips too:
+//! [`super::FootPlan::lifted_at`]).
 
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 // Indexing: frame and slot indices are bounded by `plan`'s `targets.len() / slots` and the contact

@@ -73,6 +73,7 @@ impl Problem<'_> {
             let body = foot.body;
             solver.set_weight_scale(body, plan.weight[f][side], 1.0);
             let before = f.checked_sub(1).map_or(&[][..], |b| &plan.contact[b][side][..]);
+            let rising = plan.swing_floor[f][side].is_some();
             for p in contact {
                 let (h, v) = (w * p.horizontal, w * p.vertical);
                 let weight = Vector3::new(h, h, v);
@@ -80,6 +81,17 @@ impl Problem<'_> {
                 // The points a planted sole stands on: held on their footholds.
                 if p.vertical > 0.0 && p.horizontal > 0.0 {
                     let from = before.iter().find(|b| b.point == p.point && b.vertical > 0.0);
+                    grips.push(GripPoint {
+                        body,
+                        point: p.point,
+                        at: p.at,
+                        from: from.map(|b| b.at),
+                    });
+                } else if rising && p.horizontal > 0.0 && plan.lifted_at(f, side, &p.point) {
+                    // The points a rising sole stood on at lift-off: held on their footholds
+                    // as firmly, until the sole is up (a foot leaves the floor by lifting
+                    // its last contact, not by sliding it).
+                    let from = before.iter().find(|b| b.point == p.point);
                     grips.push(GripPoint {
                         body,
                         point: p.point,
