@@ -14,6 +14,7 @@ use std::ops::Range;
 use mjcf::{JointType, Model};
 use nalgebra::Vector3;
 
+use super::footholds::Pass;
 use super::prepare::reject_divergence;
 use super::prepare::{Problem, Solved};
 use crate::ik::{FrameDiagnostics, Solver};
@@ -72,7 +73,18 @@ pub(super) fn first_pass_frame(
     f: usize,
     first: bool,
 ) -> Result<FrameDiagnostics, Error> {
-    problem.set_frame_tasks(solver, f)?;
+    first_pass_frame_in(problem, solver, f, first, Pass::Forward)
+}
+
+/// [`first_pass_frame`] in a pass that runs as `pass` says ([`Problem::set_frame_tasks_in`]).
+fn first_pass_frame_in(
+    problem: &Problem<'_>,
+    solver: &mut Solver<'_>,
+    f: usize,
+    first: bool,
+    pass: Pass,
+) -> Result<FrameDiagnostics, Error> {
+    problem.set_frame_tasks_in(solver, f, pass)?;
     let clip = &problem.clip;
     let targets = problem.frame_targets(f);
     let diagnostics = if first && !clip.pipeline.is_gmr() {
@@ -91,7 +103,8 @@ fn first_pass_backward(problem: &Problem<'_>, range: Range<usize>) -> Result<Sol
     let mut qpos = vec![0.0; range.len() * nq];
     let mut frames = vec![FrameDiagnostics::default(); range.len()];
     for (k, f) in range.clone().enumerate().rev() {
-        frames[k] = first_pass_frame(problem, &mut solver, f, f + 1 == range.end)?;
+        frames[k] =
+            first_pass_frame_in(problem, &mut solver, f, f + 1 == range.end, Pass::Backward)?;
         frames[k].backward = true;
         reject_divergence(solver.qpos(), f)?;
         qpos[k * nq..(k + 1) * nq].copy_from_slice(solver.qpos());

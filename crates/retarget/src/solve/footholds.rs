@@ -37,25 +37,29 @@ pub(super) fn plan(
     (targets, Some((feet, plan)))
 }
 
+/// Which way a pass runs through the clip's frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Pass {
+    Forward,
+    Backward,
+}
+
 impl Problem<'_> {
-    /// Frame `f`'s foot weight factors and contact-point tasks (default mode).
+    /// Frame `f`'s foot weight factors and contact-point tasks (default mode), for a pass
+    /// forward through the clip (the trajectory solve's, the first pass's).
     pub(super) fn set_frame_tasks(&self, solver: &mut Solver<'_>, f: usize) -> Result<(), Error> {
-        self.set_frame_tasks_at(solver, f, None)
+        self.set_frame_tasks_in(solver, f, Pass::Forward)
     }
 
-    /// [`Problem::set_frame_tasks`]; with `at` (kinematics of the smoothed pose a repair
-    /// starts from), also a vertical task, weighted as the contact points, that lifts each
-    /// swing sole found below its swing clearance ([`crate::feet::FootPlan::swing_floor`]) back up to it.
-    /// The smoothing filter pulls a swing foot towards its planted neighbours' height, the
-    /// further the more passes it has: ToddlerBot's (8 passes) swung 2.6–2.9 cm up (median)
-    /// in 1,500 of its LAFAN1 walk's frames, under the report's 3 cm contact height, and the
-    /// report counted 12.4 % of its contact frames as sliding (1.6 % lifted; the G1's jumps
-    /// 6.5 → 5.3 %).
-    fn set_frame_tasks_at(
+    /// [`Problem::set_frame_tasks`] for a pass that runs through the clip as `pass` says. A
+    /// grip holds a point where it was in the frame solved before; backward, that is the
+    /// frame after, and a rising sole's grips ([`crate::feet::FootPlan::lifted_at`]) would
+    /// hold it where the swing has taken it: backward, they are left out.
+    pub(super) fn set_frame_tasks_in(
         &self,
         solver: &mut Solver<'_>,
         f: usize,
-        at: Option<&mjcf::Data>,
+        pass: Pass,
     ) -> Result<(), Error> {
         let Some((feet, plan)) = &self.plan else { return Ok(()) };
         let raised: Vec<(usize, f64)> = feet
@@ -73,7 +77,7 @@ impl Problem<'_> {
             let body = foot.body;
             solver.set_weight_scale(body, plan.weight[f][side], 1.0);
             let before = f.checked_sub(1).map_or(&[][..], |b| &plan.contact[b][side][..]);
-            let rising = plan.swing_floor[f][side].is_some();
+            let rising = pass == Pass::Forward && plan.swing_floor[f][side].is_some();
             for p in contact {
                 let (h, v) = (w * p.horizontal, w * p.vertical);
                 let weight = Vector3::new(h, h, v);
@@ -97,20 +101,6 @@ impl Problem<'_> {
                         point: p.point,
                         at: p.at,
                         from: from.map(|b| b.at),
-                    });
-                }
-            }
-            if let (Some(data), Some(floor)) = (at, plan.swing_floor[f][side]) {
-                let rot = data.xquat[body];
-                let point = foot.sole_low_point(&rot);
-                let world = data.xpos[body] + rot * point;
-                if world.z < floor {
-                    let target = Vector3::new(world.x, world.y, floor);
-                    points.push(PointTask {
-                        body,
-                        point,
-                        target,
-                        weight: Vector3::new(0.0, 0.0, w),
                     });
                 }
             }
