@@ -662,7 +662,7 @@ fn a_window_step_does_not_carry_a_sole_through_the_other_ankle() {
 
 /// The root's acceleration is smoothed where its target is, at the root task's body's origin,
 /// not at the free root's (`Trajectory::root_point_terms`): the T1's root task is on its
-/// `Waist`, 13 cm below and 6 cm ahead of the free `Trunk`'s origin, and the trunk's turns
+/// `Waist`, 11.5 cm below and 6 cm ahead of the free `Trunk`'s origin, and the trunk's turns
 /// moved the `Waist` past a smooth `Trunk` origin: over the first 900 frames of the LAFAN1
 /// walk it accelerated 1.40 × its target (averaged over 1/6 s; the corpus gate's cap 1.25 ×),
 /// 1.16 × measured there.
