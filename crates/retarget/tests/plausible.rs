@@ -44,6 +44,26 @@ fn first_frames(mut bvh: bvh::Bvh, n: usize) -> bvh::Bvh {
     bvh
 }
 
+/// A shared BVH clip (`file` under the shared data; its first `frames` when given) retargeted
+/// onto the shipped `robot` as the CLI does (default solve, its config choice; `height`, else
+/// the estimated one), and its report; `None` without the shared data.
+fn shared_bvh_report(
+    file: &str,
+    frames: Option<usize>,
+    robot: &str,
+    height: Option<f64>,
+) -> Option<QualityReport> {
+    let path = shared::shared_file(file)?;
+    let bvh = bvh::from_path(&path).unwrap();
+    let bvh = match frames {
+        Some(n) => first_frames(bvh, n),
+        None => bvh,
+    };
+    let r = retarget::Retargeter::new(robot).unwrap().with_human_height(height);
+    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
+    Some(report(&motion, r.model(), &ReportOptions::default()).unwrap())
+}
+
 /// The G1, its tuned config, the shared LAFAN1 jumps take's human motion and its subject
 /// height; `None` without the shared data.
 fn g1_jumps() -> Option<(mjcf::Model, IkConfig, fk::HumanMotion, f64)> {
@@ -645,13 +665,10 @@ fn a_sweep_step_does_not_throw_the_root() {
 /// frame the sweep could not take back (its constraints relaxed).
 #[test]
 fn a_window_step_does_not_carry_a_sole_through_the_other_ankle() {
-    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+    let file = "data/bvh/lafan1_take_via_bvhtools_test.bvh";
+    let Some(report) = shared_bvh_report(file, None, "stanford_toddy", Some(1.75)) else {
         return;
     };
-    let bvh = bvh::from_path(&path).unwrap();
-    let r = retarget::Retargeter::new("stanford_toddy").unwrap().with_human_height(Some(1.75));
-    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
-    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
     let sc = &report.self_collision;
     assert_eq!(
         sc.frames_deep, 0,
@@ -668,13 +685,10 @@ fn a_window_step_does_not_carry_a_sole_through_the_other_ankle() {
 /// 1.16 × measured there.
 #[test]
 fn the_root_is_smooth_where_its_target_is() {
-    let Some(path) = shared::shared_file("data/bvh/lafan1_take_via_bvhtools_test.bvh") else {
+    let file = "data/bvh/lafan1_take_via_bvhtools_test.bvh";
+    let Some(report) = shared_bvh_report(file, Some(900), "booster_t1_29dof", None) else {
         return;
     };
-    let bvh = first_frames(bvh::from_path(&path).unwrap(), 900);
-    let r = retarget::Retargeter::new("booster_t1_29dof").unwrap();
-    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
-    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
     let a = &report.root_acceleration;
     assert_eq!(a.body, "Waist");
     let human = a.averaged.target.as_ref().unwrap().mean_mps2;
@@ -688,13 +702,10 @@ fn the_root_is_smooth_where_its_target_is() {
 /// SOMA walk (120 fps), 0.7 % of the right foot's floor frames (issue 40's bar: 0.5 %).
 #[test]
 fn a_rising_sole_lifts_its_last_contact_without_sliding_it() {
-    let Some(path) = shared::shared_file("data/soma/Neutral_walk_forward_002__A057.bvh") else {
+    let file = "data/soma/Neutral_walk_forward_002__A057.bvh";
+    let Some(report) = shared_bvh_report(file, None, "unitree_g1", None) else {
         return;
     };
-    let bvh = bvh::from_path(&path).unwrap();
-    let r = retarget::Retargeter::new("unitree_g1").unwrap();
-    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
-    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
     let worst = worst_floor_skating(&report);
     assert!(worst <= 0.005, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
