@@ -64,6 +64,26 @@ pub(super) fn first_pass<'a>(
     Ok(ahead)
 }
 
+/// A forward first pass over a whole clip that stage 4 ran with the tasks stage 5 solves
+/// (its windows covered the clip, and it left the tasks as they were): the solver as the
+/// pass left it and the solved frames, what [`first_pass`] from a new solver would return.
+pub(super) struct DonePass<'a> {
+    pub solver: Solver<'a>,
+    pub solved: Solved,
+}
+
+impl<'a> DonePass<'a> {
+    /// The solver and frames, each frame checked for divergence in order, as [`first_pass`]
+    /// checks them.
+    pub(super) fn checked(self) -> Result<(Solver<'a>, Solved), Error> {
+        let nq = self.solver.qpos().len();
+        for (f, qpos) in self.solved.qpos.chunks(nq.max(1)).enumerate() {
+            reject_divergence(qpos, f)?;
+        }
+        Ok((self.solver, self.solved))
+    }
+}
+
 /// Frame `f` of a first pass over `problem`: its foot tasks set, solved from the previous
 /// frame's pose (the `first` of a solve: from [`solve_first_frame`]'s start in the default
 /// mode, and without speed limits). Stage 4 measures the pelvis with it.

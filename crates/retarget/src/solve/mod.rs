@@ -29,8 +29,9 @@
 //!       ─3 plan────────► the targets with the feet's planted, the foot plan
 //!                        → Problem { clip, tasks, targets, contacts, plan }
 //!       ─4 reweigh─────► the Problem with its tasks reweighed (measured by stage 5's
-//!                        `first_pass_frame` on the Problem it was given), its report
-//!       ─5, 6 schedule─► per range: first_pass(&Problem, solver) → Solved,
+//!                        `first_pass_frame` on the Problem it was given), its report,
+//!                        and that pass where it was stage 5's (whole clip, tasks unchanged)
+//!       ─5, 6 schedule─► per range: first_pass(&Problem, solver) → Solved (or stage 4's),
 //!                        solve_trajectory(&Problem, solver, Solved) → Solved
 //!       → RobotMotion and ClipDiagnostics (`Problem::finish`, with the stages' reports)
 //! ```
@@ -155,14 +156,14 @@ pub(crate) fn solve_clip(
     let (targets, plan) = footholds::plan(&clip, &stages, contacts.as_ref(), targets);
     let problem = Problem { clip, stages, targets, contacts, plan };
     // 4. Reweighing: the tasks, where the config's pelvis disagrees with the robot's legs.
-    let (problem, reweighed) = reweigh::reweigh_where_planted(problem)?;
+    let (problem, reweighed, done) = reweigh::reweigh_where_planted(problem)?;
     // What the stages that ran have to say, in order.
     let reports = walked.as_ref().map(|(_, report)| report.clone()).into_iter().chain(reweighed);
     let start = Instant::now();
     // 5 and 6. The first pass and the trajectory solve of the problem, over the schedule.
     let n = problem.num_frames();
     let solved = match options.chunk {
-        None => schedule::solve_range(&problem, 0..n, 0)?,
+        None => schedule::solve_range(&problem, 0..n, 0, done)?,
         Some(chunk) => schedule::solve_chunks(&problem, chunk)?,
     };
     let seconds = start.elapsed().as_secs_f64();

@@ -13,9 +13,9 @@ use std::ops::Range;
 
 use mjcf::Model;
 
-use super::first_pass::first_pass_frame;
+use super::first_pass::{first_pass_frame, DonePass};
 use super::pipeline::ReweighOptions;
-use super::prepare::{Problem, Tasks};
+use super::prepare::{Problem, Solved, Tasks};
 use super::{StageReport, StageValue};
 use crate::ik::TaskSpec;
 use crate::Error;
@@ -24,20 +24,24 @@ use crate::Error;
 /// [`reweigh`]ed by how far the robot's pelvis stands from its target with the config's
 /// ([`pelvis_offset`]: stage 5's [`first_pass_frame`] over a few windows of that problem),
 /// and what was done. Where the stage does not run, or the config does not pin the pelvis,
-/// the problem comes back as it was, with no report.
+/// the problem comes back as it was, with no report. Where its one window was the whole
+/// clip and the tasks stay as they were (share 0), the pass it ran is stage 5's forward
+/// first pass, given back ([`DonePass`]) so that stage 5 does not run it again.
 pub(super) fn reweigh_where_planted(
     problem: Problem<'_>,
-) -> Result<(Problem<'_>, Option<StageReport>), Error> {
+) -> Result<(Problem<'_>, Option<StageReport>, Option<DonePass<'_>>), Error> {
     Ok(match reweighed_tasks(&problem)? {
-        Some((stages, report)) => (Problem { stages, ..problem }, Some(report)),
-        None => (problem, None),
+        Some((stages, report, pass)) => (Problem { stages, ..problem }, Some(report), pass),
+        None => (problem, None, None),
     })
 }
 
-/// [`reweigh_where_planted`]'s tasks and report, the share of the change set by where the
-/// offset falls in [`crate::PlausibleOptions::pelvis_offset_range`]; `None` where the tasks
-/// stay the config's.
-fn reweighed_tasks(problem: &Problem<'_>) -> Result<Option<(Tasks, StageReport)>, Error> {
+/// [`reweigh_where_planted`]'s tasks, report and pass, the share of the change set by where
+/// the offset falls in [`crate::PlausibleOptions::pelvis_offset_range`]; `None` where the
+/// tasks stay the config's.
+fn reweighed_tasks<'a>(
+    problem: &Problem<'a>,
+) -> Result<Option<(Tasks, StageReport, Option<DonePass<'a>>)>, Error> {
     let Some(options) = problem.clip.pipeline.reweigh else { return Ok(None) };
     if problem.plan.is_none() {
         return Ok(None);
@@ -51,13 +55,15 @@ fn reweighed_tasks(problem: &Problem<'_>) -> Result<Option<(Tasks, StageReport)>
     if !problem.stages.iter().flatten().any(|t| t.target == root && t.pos_weight > cap) {
         return Ok(None);
     }
-    let Some(offset) = pelvis_offset(problem)? else { return Ok(None) };
+    let Some((offset, pass)) = pelvis_offset(problem)? else { return Ok(None) };
     let [from, to] = options.pelvis_offset_range;
     let t = if to > from { ((offset - from) / (to - from)).clamp(0.0, 1.0) } else { 1.0 };
     let share = t * t * (3.0 - 2.0 * t);
     let mut stages = problem.stages.clone();
     reweigh(&mut stages, problem.clip.model, root, &options, share);
-    Ok(Some((stages, report(offset, share))))
+    // Reweighed tasks are another problem: stage 5 solves it from the start.
+    let pass = pass.filter(|_| share <= 0.0);
+    Ok(Some((stages, report(offset, share), pass)))
 }
 
 /// How far (m) the robot's pelvis stands above or below its target with `problem`'s
@@ -65,9 +71,10 @@ fn reweighed_tasks(problem: &Problem<'_>) -> Result<Option<(Tasks, StageReport)>
 /// [`PELVIS_WINDOW_S`] (at a quarter, half and three quarters of the clip, or the
 /// whole of a shorter clip), each solved from its first frame as a clip is, its first
 /// frames left out. Height only: the horizontal offsets follow the direction of travel
-/// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). `None` when no task
-/// tracks the root's position.
-fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
+/// within a window (the N1's walk: 3.3 cm in all, 0.1 cm in height). With it, where the
+/// one window was the whole clip (and stage 5 runs forward only), the pass: stage 5's
+/// forward first pass of `problem`. `None` when no task tracks the root's position.
+fn pelvis_offset<'a>(problem: &Problem<'a>) -> Result<Option<(f64, Option<DonePass<'a>>)>, Error> {
     let root_target = problem.clip.root_target;
     let root =
         problem.stages.iter().flatten().find(|t| t.target == root_target && t.pos_weight > 0.0);
@@ -76,7 +83,8 @@ fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
     let clip = &problem.clip;
     let (window_frames, settle) =
         (clip.frames_in(PELVIS_WINDOW_S).max(1), clip.frames_in(PELVIS_SETTLE_S));
-    let windows: Vec<Range<usize>> = if frames <= PELVIS_WINDOWS * window_frames {
+    let whole = frames <= PELVIS_WINDOWS * window_frames;
+    let windows: Vec<Range<usize>> = if whole {
         std::iter::once(0..frames).collect()
     } else {
         (1..=PELVIS_WINDOWS)
@@ -86,11 +94,22 @@ fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
             })
             .collect()
     };
+    // The whole clip solved forward is stage 5's first pass: kept, as `first_pass` keeps it.
+    let keep = whole && !clip.pipeline.both_ways;
+    let nq = clip.model.nq;
+    let mut solved = Solved {
+        qpos: Vec::with_capacity(if keep { frames * nq } else { 0 }),
+        frames: Vec::with_capacity(if keep { frames } else { 0 }),
+    };
     let mut solver = problem.solver()?;
     let mut heights = Vec::with_capacity(PELVIS_WINDOWS * window_frames);
     for window in windows {
         for f in window.clone() {
-            first_pass_frame(problem, &mut solver, f, f == window.start)?;
+            let diagnostics = first_pass_frame(problem, &mut solver, f, f == window.start)?;
+            if keep {
+                solved.frames.push(diagnostics);
+                solved.qpos.extend_from_slice(solver.qpos());
+            }
             if f >= window.start + settle || window.len() <= settle {
                 let target = &problem.frame_targets(f)[root_target];
                 heights.push(solver.data().xpos[body].z - target.pos.z);
@@ -101,7 +120,7 @@ fn pelvis_offset(problem: &Problem<'_>) -> Result<Option<f64>, Error> {
         return Ok(None);
     }
     let median = crate::report::percentile(&heights, 0.5);
-    Ok(Some(median.abs()))
+    Ok(Some((median.abs(), keep.then_some(DonePass { solver, solved }))))
 }
 
 /// What the reweighing says of a clip whose pelvis stood `offset` (m) above or below its

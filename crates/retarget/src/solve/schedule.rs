@@ -18,7 +18,7 @@ use std::ops::Range;
 use mjcf::Model;
 use rayon::prelude::*;
 
-use super::first_pass::first_pass;
+use super::first_pass::{first_pass, DonePass};
 use super::prepare::{Problem, Solved};
 use super::windows::solve_trajectory;
 use super::ChunkOptions;
@@ -26,20 +26,28 @@ use crate::Error;
 
 /// Frames `range` of `problem` through stages 5 and 6, from `qpos0` at `range.start −
 /// lead_in` (the lead-in's frames are solved and dropped) to a window's overlap past its end
-/// (the trajectory solve's last frames need the frames after them in view).
-pub(super) fn solve_range(
-    problem: &Problem<'_>,
+/// (the trajectory solve's last frames need the frames after them in view). `done`: stage
+/// 4's first pass of the whole clip, used instead of running it again when that is the range.
+pub(super) fn solve_range<'a>(
+    problem: &Problem<'a>,
     range: Range<usize>,
     lead_in: usize,
+    done: Option<DonePass<'a>>,
 ) -> Result<Solved, Error> {
     let nq = problem.clip.model.nq;
     let first = range.start.saturating_sub(lead_in);
     let trajectory = problem.clip.pipeline.trajectory.as_ref();
     let ahead = trajectory.map_or(0, |t| super::trajectory::overlap_frames(t, problem.clip.fps));
     let end = (range.end + ahead).min(problem.num_frames());
-    let mut solver = problem.solver()?;
-    // 5. The first pass.
-    let mut solved = first_pass(problem, &mut solver, first..end)?;
+    // 5. The first pass: stage 4's where it ran this one ([`DonePass`]: the whole clip).
+    let (mut solver, mut solved) = match done {
+        Some(pass) if first == 0 && end == problem.num_frames() => pass.checked()?,
+        _ => {
+            let mut solver = problem.solver()?;
+            let solved = first_pass(problem, &mut solver, first..end)?;
+            (solver, solved)
+        }
+    };
     // 6. The trajectory solve.
     if let (Some(options), false) = (trajectory, solved.qpos.is_empty()) {
         solved = solve_trajectory(problem, &mut solver, options, first, solved)?;
@@ -64,7 +72,9 @@ pub(super) fn solve_chunks(problem: &Problem<'_>, chunk: ChunkOptions) -> Result
     let starts: Vec<usize> = (0..n).step_by(chunk.frames).collect();
     let parts = starts
         .par_iter()
-        .map(|&start| solve_range(problem, start..(start + chunk.frames).min(n), chunk.lead_in))
+        .map(|&start| {
+            solve_range(problem, start..(start + chunk.frames).min(n), chunk.lead_in, None)
+        })
         .collect::<Result<Vec<Solved>, Error>>()?;
     let mut solved =
         Solved { qpos: Vec::with_capacity(n * model.nq), frames: Vec::with_capacity(n) };
