@@ -411,9 +411,8 @@ pub fn choose(
         return Ok(Chosen { config: bound, choice: Choice::Bound, summary });
     }
     let source = format!("<derived for {robot}>");
-    let derived_here = || -> Result<IkConfig, Error> {
-        let roles = RobotRoles::recognise(model)?;
-        derive(model, &roles, &human_body(bvh, fk_options, "the skeleton")?, &source)
+    let derived_here = |roles: &RobotRoles| -> Result<IkConfig, Error> {
+        derive(model, roles, &human_body(bvh, fk_options, "the skeleton")?, &source)
     };
     // The derived config, once made (the default solve checks the tuned one against it).
     let mut derived = None;
@@ -442,7 +441,7 @@ pub fn choose(
                 None if gmr => None,
                 None => {
                     let roles = RobotRoles::recognise(model)?;
-                    let config = derived.insert(derived_here()?);
+                    let config = derived.insert(derived_here(&roles)?);
                     contradiction(tuned, config, &roles).map(|c| c.to_string())
                 }
             };
@@ -462,7 +461,7 @@ pub fn choose(
     }
     let config = match derived {
         Some(config) => config,
-        None => derived_here()?,
+        None => derived_here(&RobotRoles::recognise(model)?)?,
     };
     let summary = format!("config derived from the roles of {robot} and of the skeleton{why_not}");
     Ok(Chosen { config, choice: Choice::Derived, summary })
