@@ -433,6 +433,10 @@ fn fold(c: char) -> char {
 /// it has none).
 #[must_use]
 pub fn instantiate(pattern: &str, side: Option<Side>) -> String {
+    // Every placeholder starts with a brace; most patterns have none.
+    if !pattern.contains('{') {
+        return pattern.to_owned();
+    }
     let fill = |left: &str, right: &str| match side {
         Some(Side::Right) => right.to_owned(),
         _ => left.to_owned(),
