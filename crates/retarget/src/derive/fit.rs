@@ -1,8 +1,6 @@
 //! Position offsets fitted to the motion: the robot copying the human's posture
 //! ([`copy_error`]), averaged ([`fitted_offset`]), and the feet's sole fit ([`sole_fit`]).
 
-use std::collections::BTreeMap;
-
 use fk::{Part, Role, Side};
 use nalgebra::{UnitQuaternion, Vector3};
 
@@ -143,22 +141,26 @@ fn copy_error(
     let target = (pelvis - mid) * root_scale
         + (points.get(&role)? - pelvis) * scale
         + Vector3::z() * (root_scale * ground);
-    // The robot's frames: the human's, knees and elbows turned back into their ranges.
-    let mut frames: BTreeMap<Role, UnitQuaternion<f64>> = BTreeMap::new();
-    let mut at: BTreeMap<Role, Vector3<f64>> = BTreeMap::new();
+    // The robot's frames: the human's, knees and elbows turned back into their ranges; per
+    // role of the chains so far, where its segment ends and its frame (at most 17 roles).
+    let mut posed: Vec<(Role, Vector3<f64>, UnitQuaternion<f64>)> =
+        Vec::with_capacity(POSE_CHAINS.len());
+    let find = |posed: &[(Role, Vector3<f64>, UnitQuaternion<f64>)], r: Role| {
+        posed.iter().find(|p| p.0 == r).map(|&(_, end, frame)| (end, frame))
+    };
     for (r, _) in POSE_CHAINS {
         let Some((from, v)) = robot.segments.get(&r) else { continue };
         let Some(c) = human.get(&r) else { continue };
         let (start, turn) = match from {
-            Some(a) => (*at.get(a)?, *frames.get(a)?),
+            Some(a) => find(&posed, *a)?,
             None => (Vector3::zeros(), *human.get(&Role::Pelvis)?),
         };
-        at.insert(r, start + turn * v);
+        let end = start + turn * v;
         let frame = match (robot.hinges.get(&r), from) {
             (Some(h), Some(_)) => turn * h.clamp(turn.inverse() * c),
             _ => *c,
         };
-        frames.insert(r, frame);
+        posed.push((r, end, frame));
         if r == role {
             break;
         }
@@ -166,7 +168,8 @@ fn copy_error(
     let own = human.get(&role)?;
     // A foot or hand keeps the human's frame (the ankle or wrist makes up for a bent knee or
     // elbow); a shin or forearm turns with its hinge.
-    let body = at.get(&role)? + frames.get(&role)? * origin;
+    let (end, frame) = find(&posed, role)?;
+    let body = end + frame * origin;
     Some(own.inverse() * (body - target))
 }
 
