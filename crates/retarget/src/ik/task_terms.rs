@@ -87,6 +87,7 @@ pub(super) fn mink_rows(
 
 /// The lean weighted Jacobian ([`super::Arithmetic::Lean`]): `Jlog = [[A, B], [0, A]]`
 /// with the body rotation folded into its blocks once.
+#[inline]
 pub(super) fn lean_rows(
     jlog: &Matrix6<f64>,
     xmat: &Matrix3<f64>,
@@ -120,6 +121,7 @@ pub(super) fn lean_rows(
 /// Adds `J̃ᵀJ̃` to the upper triangle of `h` (row-major `nv × nv`): for dofs `a ≤ b`, the
 /// dot product of their columns over the rows whose cost is not zero (the others hold
 /// only zeros), each summed in row order as a 6-term dot product would.
+#[inline]
 pub(super) fn add_gram(
     rows: &Rows,
     w: &[f64; 6],
