@@ -398,13 +398,10 @@ fn a_120_fps_take_is_no_more_jittery_than_gmr() {
 /// 1°).
 #[test]
 fn the_first_frame_starts_where_the_arms_can_follow() {
-    let Some(path) = shared::shared_file("data/bvh/bandai_dataset-1_kick_normal_001.bvh") else {
+    let file = "data/bvh/bandai_dataset-1_kick_normal_001.bvh";
+    let Some(r) = shared_bvh_report(file, Some(100), "booster_t1_29dof", None) else {
         return;
     };
-    let bvh = first_frames(bvh::from_path(&path).unwrap(), 100);
-    let retargeter = retarget::Retargeter::new("booster_t1_29dof").unwrap();
-    let (motion, _) = retargeter.retarget_bvh(&bvh).unwrap();
-    let r = report(&motion, retargeter.model(), &ReportOptions::default()).unwrap();
     let tracking = r.tracking.unwrap();
     let hand = tracking.iter().find(|b| b.body == "right_hand_link").unwrap();
     assert!(hand.rot_rad.mean < 0.35, "right hand {:.2} rad off", hand.rot_rad.mean);
@@ -589,12 +586,9 @@ fn the_same_walk_at_30_60_and_120_fps_gives_the_same_motion() {
 /// tasks held them, the smoothness of 120 frames a second outweighing them; 0.8 % held.
 #[test]
 fn planted_feet_hold_at_120_fps() {
-    let Some(path) = shared::shared_file("data/bvh/cmu_bvh11_131_03.bvh") else { return };
-    let bvh = bvh::from_path(&path).unwrap();
-    let r = retarget::Retargeter::new("unitree_g1").unwrap();
-    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
-    assert!((motion.fps - 120.0).abs() < 1e-6, "{}", motion.fps);
-    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
+    let file = "data/bvh/cmu_bvh11_131_03.bvh";
+    let Some(report) = shared_bvh_report(file, None, "unitree_g1", None) else { return };
+    assert!((report.fps - 120.0).abs() < 1e-6, "{}", report.fps);
     let worst = worst_floor_skating(&report);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
@@ -606,13 +600,10 @@ fn planted_feet_hold_at_120_fps() {
 /// frames; 0.6 % with two.
 #[test]
 fn a_planted_foot_holds_through_the_window_step() {
-    let Some(path) = shared::shared_file("data/soma/Neutral_walk_forward_002__A057.bvh") else {
+    let file = "data/soma/Neutral_walk_forward_002__A057.bvh";
+    let Some(report) = shared_bvh_report(file, None, "booster_t1_29dof", None) else {
         return;
     };
-    let bvh = bvh::from_path(&path).unwrap();
-    let r = retarget::Retargeter::new("booster_t1_29dof").unwrap();
-    let (motion, _) = r.retarget_bvh(&bvh).unwrap();
-    let report = report(&motion, r.model(), &ReportOptions::default()).unwrap();
     let worst = worst_floor_skating(&report);
     assert!(worst < 0.012, "a sole slides in {:.2} % of its floor frames", 100.0 * worst);
 }
