@@ -82,20 +82,18 @@ impl Problem<'_> {
                 let (h, v) = (w * p.horizontal, w * p.vertical);
                 let weight = Vector3::new(h, h, v);
                 points.push(PointTask { body, point: p.point, target: p.at, weight });
-                // The points a planted sole stands on: held on their footholds.
-                if p.vertical > 0.0 && p.horizontal > 0.0 {
-                    let from = before.iter().find(|b| b.point == p.point && b.vertical > 0.0);
-                    grips.push(GripPoint {
-                        body,
-                        point: p.point,
-                        at: p.at,
-                        from: from.map(|b| b.at),
-                    });
+                // Held on their footholds: the points a planted sole stands on, and as firmly
+                // the points a rising sole stood on at lift-off, until the sole is up (a foot
+                // leaves the floor by lifting its last contact, not by sliding it). Each from
+                // where the frame before had it.
+                let from = if p.vertical > 0.0 && p.horizontal > 0.0 {
+                    Some(before.iter().find(|b| b.point == p.point && b.vertical > 0.0))
                 } else if rising && p.horizontal > 0.0 && plan.lifted_at(f, side, &p.point) {
-                    // The points a rising sole stood on at lift-off: held on their footholds
-                    // as firmly, until the sole is up (a foot leaves the floor by lifting
-                    // its last contact, not by sliding it).
-                    let from = before.iter().find(|b| b.point == p.point);
+                    Some(before.iter().find(|b| b.point == p.point))
+                } else {
+                    None
+                };
+                if let Some(from) = from {
                     grips.push(GripPoint {
                         body,
                         point: p.point,
